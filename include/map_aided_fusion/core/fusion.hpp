@@ -1,0 +1,73 @@
+/**
+ * @file fusion.hpp
+ * @brief One step of the paper's temporal fusion, for one cell (scalar reference) and for a grid.
+ *
+ * In the paper's order (sections 2.3–2.5):
+ *   m'_SG,t = r(m_SG,t) ⊕ m_PG                       (refining, then Dempster with the prior)
+ *   m_MG,t  = ^α m'_MG,t−1 ⊛ m'_SG,t                 (contextual discounting, modified Yager rule)
+ *   ζ_t     = update(ζ_t−1, m_MG,t(O), ∅_FO, ∅_OF)   (counter, equation 3)
+ *   m'_MG,t = specialise(m_MG,t, ζ_t)                (equation 4)
+ */
+#pragma once
+
+#include "map_aided_fusion/core/counter.hpp"
+#include "map_aided_fusion/core/discounting.hpp"
+#include "map_aided_fusion/core/mass_grid.hpp"
+#include "map_aided_fusion/core/prior.hpp"
+#include "map_aided_fusion/core/rules.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+/// Everything one fusion step needs.
+struct FusionParams
+{
+  ContextualRates discount;  ///< α, per scan
+  CounterParams counter;     ///< δ_inc, δ_dec, γ_O, γ_∅ and the specialisation mode
+  /// @throws ParameterError naming the first parameter out of range.
+  void validate() const
+  {
+    discount.validate();
+    counter.validate();
+  }
+};
+
+/// Result of one fusion step on one cell.
+struct CellFusionResult
+{
+  MassMG mass;                 ///< m'_MG,t
+  double zeta = 0.0;           ///< ζ_t
+  ConflictMasses conflicts;    ///< ∅_FO, ∅_OF and the rest, as met by ⊛
+  bool scan_prior_total_conflict = false;  ///< r(m_SG) ⊕ m_PG met total conflict (m'_SG vacuous)
+};
+
+/// The scalar reference of one step, from the definitions (used to test the grid kernels).
+CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG& scan, const MassMG& prior,
+                          const FusionParams& params);
+
+/// Aggregates of one grid fusion step, for diagnostics.
+struct FusionStepStats
+{
+  double sum_conflict_free_occupied = 0.0;  ///< Σ ∅_FO over cells
+  double sum_conflict_occupied_free = 0.0;  ///< Σ ∅_OF over cells
+  double sum_conflict_other = 0.0;          ///< Σ remaining conflict over cells
+  std::size_t num_cells = 0;
+  double meanConflict() const
+  {
+    return num_cells ? (sum_conflict_free_occupied + sum_conflict_occupied_free + sum_conflict_other) / num_cells : 0.0;
+  }
+};
+
+/**
+ * @brief One fusion step on a whole grid, in place, all stages fused in one pass over the cells.
+ *
+ * @param map    the MapGrid m'_MG,t−1 with its counter; becomes m'_MG,t.
+ * @param scan   the ScanGrid already in @p map's cells (same geometry).
+ * @param prior  the prior window of the same geometry, or nullptr for a vacuous prior.
+ * @throws std::invalid_argument when the geometries differ.
+ */
+void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
+                FusionStepStats* stats = nullptr);
+
+}  // namespace core
+}  // namespace map_aided_fusion

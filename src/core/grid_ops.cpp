@@ -1,0 +1,208 @@
+#include "map_aided_fusion/core/grid_ops.hpp"
+
+#include <stdexcept>
+
+#include "cell_kernels.hpp"
+#include "map_aided_fusion/core/rules.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+using kernels::kSubsets;
+
+namespace {
+
+void requireSameGeometry(const GridGeometry& a, const GridGeometry& b, const char* what)
+{
+  if (a != b) throw std::invalid_argument(std::string(what) + ": grids of different geometry");
+}
+
+}  // namespace
+
+MAF_TARGET_CLONES
+void refineGrid(const ScanMassGrid& scan, MapMassGrid& out)
+{
+  if (out.geometry() != scan.geometry()) out.reset(scan.geometry());
+  const std::size_t n = scan.numCells();
+  const float* __restrict e = scan.plane(FrameSG::kEmpty);
+  const float* __restrict f = scan.plane(FrameSG::kF);
+  const float* __restrict o = scan.plane(FrameSG::kO);
+  const float* __restrict w = scan.plane(FrameSG::kOmega);
+  for (int a = 0; a < kSubsets; ++a)
+  {
+    float* __restrict dst = out.plane(static_cast<Subset>(a));
+    const float* src = a == 0 ? e : a == FrameMG::kF ? f : a == FrameMG::kO ? o : a == FrameMG::kOmega ? w : nullptr;
+    if (src)
+      std::copy(src, src + n, dst);
+    else
+      std::fill(dst, dst + n, 0.0f);
+  }
+  std::fill(out.counter(), out.counter() + n, 0.0f);
+}
+
+MAF_TARGET_CLONES
+void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
+{
+  requireSameGeometry(grid.geometry(), prior.geometry, "combineWithPriorGrid");
+  const std::size_t n = grid.numCells();
+  const std::size_t stride = grid.stride();
+  float* __restrict base = grid.plane(0);
+  const float* __restrict pb = prior.building.data();
+  const float* __restrict pr = prior.road.data();
+  const float* __restrict pt = prior.other.data();
+  const float threshold = static_cast<float>(kTotalConflictThreshold);
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    float m[kSubsets];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
+    const float b = pb[i], r = pr[i], t = pt[i];
+    const float u = 1.0f - b - r - t;
+    float c[kSubsets];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) c[a] = u * m[a];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a)
+    {
+      c[a & FrameMG::kBuilding] += b * m[a];
+      c[a & FrameMG::kRoad] += r * m[a];
+      c[a & FrameMG::kOther] += t * m[a];
+    }
+    const float norm = 1.0f - c[0];
+    const bool total = norm < threshold;
+    const float inv = total ? 0.0f : 1.0f / norm;
+    c[0] = 0.0f;
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) c[a] *= inv;
+    c[FrameMG::kOmega] += total ? 1.0f : 0.0f;
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = c[a];
+  }
+}
+
+MAF_TARGET_CLONES
+void contextualDiscountGrid(MapMassGrid& grid, const ContextualRates& rates)
+{
+  const ContextualDiscountWeights<float> w(rates);
+  const std::size_t n = grid.numCells();
+  const std::size_t stride = grid.stride();
+  float* __restrict base = grid.plane(0);
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    float m[kSubsets];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
+    kernels::contextualDiscount(m, w);
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = m[a];
+  }
+}
+
+MAF_TARGET_CLONES
+void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassGrid& out,
+                       float* conflict_free_occupied, float* conflict_occupied_free)
+{
+  requireSameGeometry(map.geometry(), scan.geometry(), "modifiedYagerGrid");
+  if (&out != &map && out.geometry() != map.geometry()) out.reset(map.geometry());
+  const std::size_t n = map.numCells();
+  const std::size_t stride = map.stride();
+  const float* mb = map.plane(0);
+  const float* sb = scan.plane(0);
+  float* ob = out.plane(0);
+  if (&out != &map) std::copy(map.counter(), map.counter() + n, out.counter());
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    float m1[kSubsets], m2[kSubsets], c[kSubsets];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a)
+    {
+      m1[a] = mb[a * stride + i];
+      m2[a] = sb[a * stride + i];
+      c[a] = 0.0f;
+    }
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a)
+    {
+      MAF_UNROLL
+      for (int b = 0; b < kSubsets; ++b) c[a & b] += m1[a] * m2[b];
+    }
+    const float fo = m1[FrameMG::kF] * kernels::occupiedMass(m2);
+    const float of = kernels::occupiedMass(m1) * m2[FrameMG::kF];
+    c[FrameMG::kV] += fo;
+    c[FrameMG::kOmega] += c[0] - fo;
+    c[0] = 0.0f;
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) ob[a * stride + i] = c[a];
+    if (conflict_free_occupied) conflict_free_occupied[i] = fo;
+    if (conflict_occupied_free) conflict_occupied_free[i] = of;
+  }
+}
+
+MAF_TARGET_CLONES
+void updateCounterAndSpecialiseGrid(MapMassGrid& grid, const float* conflict_free_occupied,
+                                    const float* conflict_occupied_free, const CounterParams& params)
+{
+  params.validate();
+  const std::size_t n = grid.numCells();
+  const std::size_t stride = grid.stride();
+  float* __restrict base = grid.plane(0);
+  float* __restrict zeta = grid.counter();
+  const float di = static_cast<float>(params.delta_inc), dd = static_cast<float>(params.delta_dec);
+  const float go = static_cast<float>(params.gamma_occupied), gc = static_cast<float>(params.gamma_conflict);
+  const bool literal = params.mode == SpecialisationMode::kLiteral;
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    float m[kSubsets];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
+    const float conflict = conflict_free_occupied[i] + conflict_occupied_free[i];
+    const float z = kernels::updateCounter(zeta[i], kernels::occupiedMass(m), conflict, di, dd, go, gc);
+    zeta[i] = z;
+    kernels::specialise(m, z, literal);
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = m[a];
+  }
+}
+
+MAF_TARGET_CLONES
+void pignisticGrid(const MapMassGrid& grid, PignisticPlanes& out)
+{
+  const std::size_t n = grid.numCells();
+  const std::size_t stride = grid.stride();
+  for (auto& p : out.p) p.resize(n);
+  const float* __restrict base = grid.plane(0);
+  float* __restrict p0 = out.p[0].data();
+  float* __restrict p1 = out.p[1].data();
+  float* __restrict p2 = out.p[2].data();
+  float* __restrict p3 = out.p[3].data();
+  float* __restrict p4 = out.p[4].data();
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    float acc[FrameMG::kSize] = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
+    MAF_UNROLL
+    for (int a = 1; a < kSubsets; ++a)
+    {
+      const float share = base[a * stride + i] * (1.0f / cardinality(static_cast<Subset>(a)));
+      MAF_UNROLL
+      for (int e = 0; e < FrameMG::kSize; ++e)
+        if (a & (1 << e)) acc[e] += share;
+    }
+    const float norm = 1.0f - base[i];
+    const bool none = norm <= 0.0f;
+    const float inv = none ? 0.0f : 1.0f / norm;
+    const float uniform = none ? 1.0f / FrameMG::kSize : 0.0f;
+    p0[i] = acc[0] * inv + uniform;
+    p1[i] = acc[1] * inv + uniform;
+    p2[i] = acc[2] * inv + uniform;
+    p3[i] = acc[3] * inv + uniform;
+    p4[i] = acc[4] * inv + uniform;
+  }
+}
+
+}  // namespace core
+}  // namespace map_aided_fusion

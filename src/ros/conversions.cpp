@@ -1,0 +1,217 @@
+#include "map_aided_fusion/ros/conversions.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace map_aided_fusion {
+
+using core::FrameMG;
+using core::Subset;
+
+namespace {
+
+constexpr float kOccupancyScale = 100.0f;
+constexpr std::int8_t kUnknownOccupancy = -1;
+
+std::int8_t toOccupancyValue(float p)
+{
+  return static_cast<std::int8_t>(std::lround(std::clamp(p, 0.0f, 1.0f) * kOccupancyScale));
+}
+
+template <class Frame>
+void checkClasses(const EvidentialGrid& msg)
+{
+  bool ok = msg.classes.size() == Frame::kNames.size();
+  for (std::size_t i = 0; ok && i < msg.classes.size(); ++i) ok = msg.classes[i] == Frame::kNames[i];
+  if (!ok)
+  {
+    std::string expected, got;
+    for (const auto& n : Frame::kNames) expected += std::string(n) + " ";
+    for (const auto& n : msg.classes) got += n + " ";
+    throw ConversionError("EvidentialGrid: classes [" + got + "] are not the expected [" + expected + "]");
+  }
+}
+
+void checkSizes(const EvidentialGrid& msg, std::size_t n)
+{
+  if (msg.masses.size() != msg.focal_sets.size() * n)
+    throw ConversionError("EvidentialGrid: masses has " + std::to_string(msg.masses.size()) + " values, expected " +
+                          std::to_string(msg.focal_sets.size()) + " layers x " + std::to_string(n) + " cells");
+  if (!msg.counter.empty() && msg.counter.size() != n)
+    throw ConversionError("EvidentialGrid: counter has " + std::to_string(msg.counter.size()) + " values, expected " +
+                          std::to_string(n));
+}
+
+void fillHeader(const std_msgs::Header& header, const core::GridGeometry& g, nav_msgs::OccupancyGrid& out)
+{
+  out.header = header;
+  GridConversions::toMapMetaData(g, out.info);
+  out.info.map_load_time = header.stamp;
+  out.data.resize(g.numCells());
+}
+
+}  // namespace
+
+void GridConversions::toMapMetaData(const core::GridGeometry& g, nav_msgs::MapMetaData& info)
+{
+  info.resolution = static_cast<float>(g.resolution);
+  info.width = static_cast<std::uint32_t>(g.width);
+  info.height = static_cast<std::uint32_t>(g.height);
+  info.origin.position.x = g.origin_x;
+  info.origin.position.y = g.origin_y;
+  info.origin.position.z = 0.0;
+  info.origin.orientation.x = 0.0;
+  info.origin.orientation.y = 0.0;
+  info.origin.orientation.z = 0.0;
+  info.origin.orientation.w = 1.0;
+}
+
+core::GridGeometry GridConversions::fromMapMetaData(const nav_msgs::MapMetaData& info)
+{
+  const auto& q = info.origin.orientation;
+  const double yaw_tolerance = 1e-6;
+  if (std::abs(q.x) > yaw_tolerance || std::abs(q.y) > yaw_tolerance || std::abs(q.z) > yaw_tolerance)
+    throw ConversionError("MapMetaData: rotated grid origins are not supported");
+  if (!(info.resolution > 0.0f) || !std::isfinite(info.resolution))
+    throw ConversionError("MapMetaData: resolution must be > 0");
+  core::GridGeometry g;
+  g.resolution = info.resolution;
+  g.width = static_cast<int>(info.width);
+  g.height = static_cast<int>(info.height);
+  g.origin_x = info.origin.position.x;
+  g.origin_y = info.origin.position.y;
+  return g;
+}
+
+template <class Frame>
+void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msgs::Header& header,
+                                EvidentialGrid& msg, PlaneSelection planes, bool with_counter)
+{
+  const std::size_t n = grid.numCells();
+  msg.header = header;
+  toMapMetaData(grid.geometry(), msg.info);
+  msg.info.map_load_time = header.stamp;
+  msg.classes.assign(Frame::kNames.begin(), Frame::kNames.end());
+  msg.focal_sets.clear();
+  for (int a = 0; a < Frame::kNumSubsets; ++a)
+  {
+    const float* p = grid.plane(static_cast<Subset>(a));
+    if (planes == PlaneSelection::kAll || std::any_of(p, p + n, [](float v) { return v != 0.0f; }))
+      msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
+  }
+  msg.masses.resize(msg.focal_sets.size() * n);
+  for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
+  {
+    const float* p = grid.plane(msg.focal_sets[k]);
+    std::copy(p, p + n, msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n));
+  }
+  if (with_counter)
+    msg.counter.assign(grid.counter(), grid.counter() + n);
+  else
+    msg.counter.clear();
+}
+
+template <class Frame>
+void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Frame>& grid)
+{
+  checkClasses<Frame>(msg);
+  const core::GridGeometry g = fromMapMetaData(msg.info);
+  const std::size_t n = g.numCells();
+  checkSizes(msg, n);
+  std::uint64_t seen = 0;
+  for (auto a : msg.focal_sets)
+  {
+    if (a >= Frame::kNumSubsets)
+      throw ConversionError("EvidentialGrid: focal set " + std::to_string(a) + " is outside the frame");
+    if (seen & (1ull << a))
+      throw ConversionError("EvidentialGrid: focal set " + core::subsetName<Frame>(a) + " appears twice");
+    seen |= 1ull << a;
+  }
+  if (grid.geometry() != g)
+    grid.reset(g);
+  for (int a = 0; a < Frame::kNumSubsets; ++a) std::fill_n(grid.plane(static_cast<Subset>(a)), n, 0.0f);
+  for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
+    std::copy_n(msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n), n, grid.plane(msg.focal_sets[k]));
+  if (msg.counter.empty())
+    std::fill_n(grid.counter(), n, 0.0f);
+  else
+    std::copy(msg.counter.begin(), msg.counter.end(), grid.counter());
+}
+
+template void GridConversions::toMessage(const core::MassGrid<FrameMG>&, const std_msgs::Header&, EvidentialGrid&,
+                                         PlaneSelection, bool);
+template void GridConversions::toMessage(const core::MassGrid<core::FrameSG>&, const std_msgs::Header&,
+                                         EvidentialGrid&, PlaneSelection, bool);
+template void GridConversions::fromMessage(const EvidentialGrid&, core::MassGrid<FrameMG>&);
+template void GridConversions::fromMessage(const EvidentialGrid&, core::MassGrid<core::FrameSG>&);
+
+void GridConversions::fromMessage(const EvidentialGrid& msg, core::PriorWindow& prior)
+{
+  checkClasses<FrameMG>(msg);
+  const core::GridGeometry g = fromMapMetaData(msg.info);
+  const std::size_t n = g.numCells();
+  checkSizes(msg, n);
+  prior.reset(g);
+  for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
+  {
+    const auto a = msg.focal_sets[k];
+    const auto first = msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n);
+    if (a == FrameMG::kBuilding)
+      std::copy_n(first, n, prior.building.begin());
+    else if (a == FrameMG::kRoad)
+      std::copy_n(first, n, prior.road.begin());
+    else if (a == FrameMG::kOther)
+      std::copy_n(first, n, prior.other.begin());
+    else if (a != FrameMG::kOmega && a != FrameMG::kEmpty && std::any_of(first, first + n, [](float v) { return v != 0.0f; }))
+      throw ConversionError("EvidentialGrid: a prior grid cannot carry mass on " + core::subsetName<FrameMG>(a) +
+                            " (only B, R, T and Omega)");
+  }
+}
+
+void GridConversions::toMessage(const core::PriorWindow& prior, const std_msgs::Header& header, EvidentialGrid& msg)
+{
+  const std::size_t n = prior.geometry.numCells();
+  msg.header = header;
+  toMapMetaData(prior.geometry, msg.info);
+  msg.info.map_load_time = header.stamp;
+  msg.classes.assign(FrameMG::kNames.begin(), FrameMG::kNames.end());
+  msg.focal_sets = { FrameMG::kBuilding, FrameMG::kRoad, FrameMG::kOther, FrameMG::kOmega };
+  msg.masses.resize(4 * n);
+  auto out = msg.masses.begin();
+  out = std::copy(prior.building.begin(), prior.building.end(), out);
+  out = std::copy(prior.road.begin(), prior.road.end(), out);
+  out = std::copy(prior.other.begin(), prior.other.end(), out);
+  for (std::size_t i = 0; i < n; ++i) *out++ = 1.0f - prior.building[i] - prior.road[i] - prior.other[i];
+  msg.counter.clear();
+}
+
+void GridConversions::pignisticToOccupancy(const core::MapMassGrid& grid, const core::PignisticPlanes& betp,
+                                           int element, const std_msgs::Header& header, nav_msgs::OccupancyGrid& out,
+                                           float vacuous_tolerance)
+{
+  if (element < 0 || element >= FrameMG::kSize)
+    throw ConversionError("pignisticToOccupancy: element " + std::to_string(element) + " is not in the frame");
+  fillHeader(header, grid.geometry(), out);
+  const float* omega = grid.plane(FrameMG::kOmega);
+  const auto& p = betp[element];
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+    out.data[i] = omega[i] >= 1.0f - vacuous_tolerance ? kUnknownOccupancy : toOccupancyValue(p[i]);
+}
+
+void GridConversions::scanToOccupancy(const core::ScanMassGrid& grid, const std_msgs::Header& header,
+                                      nav_msgs::OccupancyGrid& out, float vacuous_tolerance)
+{
+  fillHeader(header, grid.geometry(), out);
+  const float* f = grid.plane(core::FrameSG::kF);
+  const float* o = grid.plane(core::FrameSG::kO);
+  const float* omega = grid.plane(core::FrameSG::kOmega);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    const float norm = f[i] + o[i] + omega[i];
+    out.data[i] = omega[i] >= 1.0f - vacuous_tolerance || norm <= 0.0f
+                      ? kUnknownOccupancy
+                      : toOccupancyValue((o[i] + 0.5f * omega[i]) / norm);
+  }
+}
+
+}  // namespace map_aided_fusion

@@ -1,0 +1,261 @@
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "map_aided_fusion/core/fusion.hpp"
+#include "map_aided_fusion/core/grid_ops.hpp"
+#include "map_aided_fusion/core/pignistic.hpp"
+#include "test_util.hpp"
+
+using namespace map_aided_fusion::core;
+using maf_test::isValidMass;
+using maf_test::massNear;
+using maf_test::randomMass;
+
+namespace {
+
+constexpr double kFloatTolerance = 2e-5;
+
+/// An odd-sized geometry so that vector loops have a remainder.
+GridGeometry testGeometry() { return GridGeometry{ 0.5, 37, 23, -3.0, 4.5 }; }
+
+MapMassGrid randomMapGrid(std::mt19937& rng, const GridGeometry& g, bool with_counter = true)
+{
+  MapMassGrid grid(g);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    grid.setCell(i, randomMass<FrameMG>(rng, 8));
+    if (with_counter) grid.counter()[i] = static_cast<float>(u(rng));
+  }
+  return grid;
+}
+
+ScanMassGrid randomScanGrid(std::mt19937& rng, const GridGeometry& g)
+{
+  ScanMassGrid grid(g);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    auto m = randomMass<FrameSG>(rng, 3);
+    if (i % 7 == 0) m = MassSG{ { FrameSG::kF, 1.0 } };  // certain free: total conflict on buildings
+    grid.setCell(i, m);
+  }
+  return grid;
+}
+
+PriorWindow randomPrior(std::mt19937& rng, const GridGeometry& g, const PriorConfidence& beta)
+{
+  PriorWindow p(g);
+  std::uniform_int_distribution<int> cls(0, kNumPriorClasses - 1);
+  for (std::size_t i = 0; i < g.numCells(); ++i)
+  {
+    const auto c = static_cast<PriorClass>(cls(rng));
+    const auto m = priorMass(c, beta);
+    p.building[i] = static_cast<float>(m[FrameMG::kBuilding]);
+    p.road[i] = static_cast<float>(m[FrameMG::kRoad]);
+    p.other[i] = static_cast<float>(m[FrameMG::kOther]);
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(GridGeometry, WorldCellRoundTripAndRowMajorIndex)
+{
+  const GridGeometry g{ 0.25, 40, 20, -5.0, -2.5 };
+  EXPECT_NO_THROW(g.validate());
+  CellIndex c;
+  ASSERT_TRUE(g.worldToCell(Point2{ -5.0, -2.5 }, c));
+  EXPECT_EQ(c, (CellIndex{ 0, 0 }));
+  ASSERT_TRUE(g.worldToCell(Point2{ 4.99, 2.49 }, c));
+  EXPECT_EQ(c, (CellIndex{ 39, 19 }));
+  EXPECT_FALSE(g.worldToCell(Point2{ 5.0, 0.0 }, c));
+  EXPECT_FALSE(g.worldToCell(Point2{ -5.01, 0.0 }, c));
+  EXPECT_FALSE(g.worldToCell(Point2{ std::nan(""), 0.0 }, c));
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x)
+    {
+      const auto p = g.cellCentre(CellIndex{ x, y });
+      ASSERT_TRUE(g.worldToCell(p, c));
+      EXPECT_EQ(c, (CellIndex{ x, y }));
+      EXPECT_EQ(g.index(c), static_cast<std::size_t>(y * g.width + x));
+      EXPECT_EQ(g.cellOf(g.index(c)), c);
+    }
+  const auto centred = GridGeometry::centred(100.0, 100.0, 0.5);
+  EXPECT_EQ(centred.width, 200);
+  EXPECT_DOUBLE_EQ(centred.origin_x, -50.0);
+  EXPECT_THROW((GridGeometry{ 0.0, 10, 10, 0, 0 }.validate()), ParameterError);
+  EXPECT_THROW((GridGeometry{ 0.5, 0, 10, 0, 0 }.validate()), ParameterError);
+}
+
+TEST(MassGrid, PlanesAreAlignedAndStartVacuous)
+{
+  MapMassGrid grid(testGeometry());
+  for (int a = 0; a < 32; ++a)
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.plane(static_cast<Subset>(a))) % 64, 0u);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.counter()) % 64, 0u);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    EXPECT_TRUE(massNear(grid.cell(i), MassMG::vacuous(), 0.0));
+    EXPECT_EQ(grid.counter()[i], 0.0f);
+  }
+}
+
+TEST(GridOps, RefineMatchesScalar)
+{
+  std::mt19937 rng(1);
+  const auto scan = randomScanGrid(rng, testGeometry());
+  MapMassGrid out;
+  refineGrid(scan, out);
+  for (std::size_t i = 0; i < scan.numCells(); ++i) ASSERT_TRUE(massNear(out.cell(i), refine(scan.cell(i)), 1e-7));
+}
+
+TEST(GridOps, PriorDempsterMatchesScalar)
+{
+  std::mt19937 rng(2);
+  const PriorConfidence beta{ 1.0, 0.85, 0.7 };  // β_B = 1: total conflict with certain free cells
+  const auto scan = randomScanGrid(rng, testGeometry());
+  const auto prior = randomPrior(rng, testGeometry(), beta);
+  MapMassGrid grid;
+  refineGrid(scan, grid);
+  combineWithPriorGrid(grid, prior);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    const auto expected = dempster(refine(scan.cell(i)), prior.cell(i));
+    ASSERT_TRUE(massNear(grid.cell(i), expected, kFloatTolerance)) << "cell " << i;
+    ASSERT_TRUE(isValidMass(grid.cell(i), kFloatTolerance));
+  }
+}
+
+TEST(GridOps, ContextualDiscountMatchesScalar)
+{
+  std::mt19937 rng(3);
+  auto grid = randomMapGrid(rng, testGeometry());
+  const auto before = grid;
+  const ContextualRates rates{ 0.05, 0.3, 0.15 };
+  contextualDiscountGrid(grid, rates);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+    ASSERT_TRUE(massNear(grid.cell(i), contextualDiscount(before.cell(i), rates), kFloatTolerance));
+}
+
+TEST(GridOps, ModifiedYagerMatchesScalar)
+{
+  std::mt19937 rng(4);
+  const auto a = randomMapGrid(rng, testGeometry());
+  const auto b = randomMapGrid(rng, testGeometry());
+  MapMassGrid out;
+  std::vector<float> fo(a.numCells()), of(a.numCells());
+  modifiedYagerGrid(a, b, out, fo.data(), of.data());
+  for (std::size_t i = 0; i < a.numCells(); ++i)
+  {
+    ConflictMasses c;
+    const auto expected = modifiedYager(a.cell(i), b.cell(i), &c);
+    ASSERT_TRUE(massNear(out.cell(i), expected, kFloatTolerance)) << "cell " << i;
+    EXPECT_NEAR(fo[i], c.free_occupied, kFloatTolerance);
+    EXPECT_NEAR(of[i], c.occupied_free, kFloatTolerance);
+  }
+}
+
+TEST(GridOps, CounterAndSpecialisationMatchScalar)
+{
+  for (auto mode : { SpecialisationMode::kMovingToStopped, SpecialisationMode::kLiteral })
+  {
+    std::mt19937 rng(5);
+    auto grid = randomMapGrid(rng, testGeometry());
+    const auto before = grid;
+    std::uniform_real_distribution<float> u(0.0f, 0.2f);
+    std::vector<float> fo(grid.numCells()), of(grid.numCells());
+    for (auto& v : fo) v = u(rng);
+    for (auto& v : of) v = u(rng);
+    CounterParams p;
+    p.mode = mode;
+    p.delta_inc = 0.2;
+    p.gamma_occupied = 0.3;
+    updateCounterAndSpecialiseGrid(grid, fo.data(), of.data(), p);
+    for (std::size_t i = 0; i < grid.numCells(); ++i)
+    {
+      const auto m = before.cell(i);
+      const double zeta =
+          updateCounter(before.counter()[i], m.massInside(FrameMG::kO), ConflictMasses{ fo[i], of[i], 0.0 }, p);
+      ASSERT_NEAR(grid.counter()[i], zeta, 1e-6) << "cell " << i;
+      ASSERT_TRUE(massNear(grid.cell(i), specialise(m, zeta, mode), kFloatTolerance)) << "cell " << i;
+    }
+  }
+}
+
+TEST(GridOps, PignisticMatchesScalar)
+{
+  std::mt19937 rng(6);
+  const auto grid = randomMapGrid(rng, testGeometry());
+  PignisticPlanes p;
+  pignisticGrid(grid, p);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    const auto expected = pignistic(grid.cell(i));
+    for (int e = 0; e < 5; ++e) ASSERT_NEAR(p[e][i], expected[e], kFloatTolerance);
+  }
+}
+
+TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
+{
+  for (auto mode : { SpecialisationMode::kMovingToStopped, SpecialisationMode::kLiteral })
+    for (bool with_prior : { true, false })
+    {
+      std::mt19937 rng(8);
+      const auto g = testGeometry();
+      const PriorConfidence beta{ 1.0, 0.85, 0.7 };
+      auto map = randomMapGrid(rng, g);
+      const auto before = map;
+      const auto scan = randomScanGrid(rng, g);
+      const auto prior = randomPrior(rng, g, beta);
+      FusionParams params;
+      params.counter.mode = mode;
+      params.counter.gamma_conflict = 0.3;
+      params.counter.gamma_occupied = 0.4;
+      FusionStepStats stats;
+      fusionStep(map, scan, with_prior ? &prior : nullptr, params, &stats);
+
+      // The same, one stage at a time.
+      MapMassGrid staged_scan;
+      refineGrid(scan, staged_scan);
+      if (with_prior) combineWithPriorGrid(staged_scan, prior);
+      auto staged = before;
+      contextualDiscountGrid(staged, params.discount);
+      std::vector<float> fo(g.numCells()), of(g.numCells());
+      modifiedYagerGrid(staged, staged_scan, staged, fo.data(), of.data());
+      updateCounterAndSpecialiseGrid(staged, fo.data(), of.data(), params.counter);
+
+      double sum_fo = 0, sum_of = 0, sum_other = 0;
+      for (std::size_t i = 0; i < map.numCells(); ++i)
+      {
+        const auto ref = fuseCell(before.cell(i), before.counter()[i], scan.cell(i),
+                                  with_prior ? prior.cell(i) : MassMG::vacuous(), params);
+        ASSERT_TRUE(massNear(map.cell(i), ref.mass, kFloatTolerance)) << "cell " << i;
+        ASSERT_NEAR(map.counter()[i], ref.zeta, 1e-6) << "cell " << i;
+        ASSERT_TRUE(isValidMass(map.cell(i), kFloatTolerance));
+        ASSERT_TRUE(massNear(staged.cell(i), map.cell(i), kFloatTolerance)) << "cell " << i;
+        ASSERT_NEAR(staged.counter()[i], map.counter()[i], 1e-6);
+        sum_fo += ref.conflicts.free_occupied;
+        sum_of += ref.conflicts.occupied_free;
+        sum_other += ref.conflicts.other;
+      }
+      EXPECT_EQ(stats.num_cells, map.numCells());
+      EXPECT_NEAR(stats.sum_conflict_free_occupied, sum_fo, 1e-3);
+      EXPECT_NEAR(stats.sum_conflict_occupied_free, sum_of, 1e-3);
+      EXPECT_NEAR(stats.sum_conflict_other, sum_other, 1e-3);
+    }
+}
+
+TEST(FusionStep, RejectsMismatchedGeometries)
+{
+  MapMassGrid map(testGeometry());
+  auto other = testGeometry();
+  other.width += 1;
+  ScanMassGrid scan(other);
+  EXPECT_THROW(fusionStep(map, scan, nullptr, FusionParams{}), std::invalid_argument);
+  FusionParams bad;
+  bad.discount.alpha_free = 3.0;
+  ScanMassGrid ok(testGeometry());
+  EXPECT_THROW(fusionStep(map, ok, nullptr, bad), ParameterError);
+}
