@@ -16,3 +16,19 @@ install(TARGETS map_aided_fusion_map_io
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# ---- Core: scanline rasteriser and PriorGrid (ROS-free) ---------------------------------------
+target_sources(map_aided_fusion_core PRIVATE src/core/prior_grid.cpp)
+
+# ---- Tests --------------------------------------------------------------------------------------
+if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(test_prior_grid test/prior/test_prior_grid.cpp test/test_main.cpp)
+  target_link_libraries(test_prior_grid map_aided_fusion_core)
+
+  catkin_add_gtest(test_map_loader test/prior/test_map_loader.cpp test/test_main.cpp)
+  target_link_libraries(test_map_loader map_aided_fusion_map_io ${GeographicLib_LIBRARIES})
+  target_include_directories(test_map_loader SYSTEM PRIVATE ${GeographicLib_INCLUDE_DIRS})
+  target_compile_definitions(test_map_loader PRIVATE
+    MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data"
+    MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+endif()

@@ -6,7 +6,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <cstdio>
+#include <cstring>
 #include <memory>
+#include <set>
 #include <mutex>
 #include <sstream>
 
@@ -113,10 +116,12 @@ std::string osmConfig(const MapLoadParams& p)
 {
   const std::string common = "osm_id=yes\nosm_version=no\nosm_timestamp=no\nosm_uid=no\nosm_user=no\nosm_changeset=no\n";
   std::ostringstream c;
-  c << "closed_ways_are_polygons=" << p.building_attribute << "," << p.road_area_attribute << "\n";
+  // Closed ways are read as lines and made polygons here: GDAL reports missing nodes only for lines.
+  c << "closed_ways_are_polygons=map_aided_fusion_no_key\n";
   c << "attribute_name_laundering=no\n";
   c << "[points]\n" << common << "attributes=name\n";
-  c << "[lines]\n" << common << "attributes=name," << p.building_attribute << "," << p.road_class_attribute << ","
+  c << "[lines]\n" << common << "attributes=name," << p.building_attribute << "," << p.building_height_attribute
+    << "," << p.building_levels_attribute << "," << p.road_class_attribute << ","
     << p.road_width_attribute << "," << p.road_lanes_attribute << "," << p.road_area_attribute << ",area\n";
   c << "[multipolygons]\n" << common << "attributes=name,type," << p.building_attribute << ","
     << p.building_height_attribute << "," << p.building_levels_attribute << "," << p.road_class_attribute << ","
@@ -171,7 +176,10 @@ public:
   ErrorCapture(const ErrorCapture&) = delete;
   ErrorCapture& operator=(const ErrorCapture&) = delete;
   const std::string& last() const { return last_; }
-  std::size_t missingNodeMessages() const { return missing_nodes_; }
+  /// Ways the OSM driver dropped because fewer than 2 of their nodes are in the extract.
+  std::size_t discardedWays() const { return discarded_ways_; }
+  /// Ways the OSM driver shortened because some of their nodes are missing from the extract.
+  bool truncated(long long way_id) const { return truncated_ways_.count(way_id) > 0; }
 
 private:
   static void CPL_STDCALL handler(CPLErr level, CPLErrorNum, const char* msg)
@@ -181,8 +189,13 @@ private:
     const std::string m(msg);
     if (level == CE_Debug)
     {
-      if (m.find("Cannot find node") != std::string::npos || m.find("could be found") != std::string::npos)
-        ++self->missing_nodes_;
+      long long id = 0;
+      int got = 0, want = 0;
+      const char* text = std::strstr(msg, "For way ");
+      if (text != nullptr && std::sscanf(text, "For way %lld, got only %d nodes instead of %d", &id, &got, &want) == 3)
+        self->truncated_ways_.insert(id);
+      else if (m.find("nodes that could be found. Discarding it") != std::string::npos)
+        ++self->discarded_ways_;
       return;
     }
     self->last_ = m;
@@ -190,7 +203,8 @@ private:
   std::string last_;
   std::string saved_debug_;
   bool had_debug_ = false;
-  std::size_t missing_nodes_ = 0;
+  std::size_t discarded_ways_ = 0;
+  std::set<long long> truncated_ways_;
 };
 
 class Loader
@@ -398,20 +412,21 @@ private:
       geometry = linear.get();
     }
     std::unique_ptr<OGRGeometry> repaired;
+    std::vector<const OGRPolygon*> polygons;
     if (p_.repair_invalid && !geometry->IsValid())
     {
       repaired.reset(geometry->MakeValid());
-      if (!repaired || repaired->IsEmpty() || !repaired->IsValid())
+      if (repaired && !repaired->IsEmpty() && repaired->IsValid()) collectPolygons(repaired.get(), polygons);
+      if (polygons.empty())
       {
         ++r_.skipped_invalid;
         note(id, "invalid polygon that could not be repaired");
         return;
       }
       ++r_.repaired_geometries;
-      geometry = repaired.get();
     }
-    std::vector<const OGRPolygon*> polygons;
-    collectPolygons(geometry, polygons);
+    else
+      collectPolygons(geometry, polygons);
     if (polygons.empty()) return skipDegenerate(id, "no polygon in the geometry");
     bool any = false;
     for (const OGRPolygon* poly : polygons)
@@ -431,6 +446,19 @@ private:
         areas_.push_back(std::move(raw));
     }
     if (!any) skipDegenerate(id, "polygon with fewer than 3 distinct vertices");
+  }
+
+  /// A closed line string (first vertex = last, ≥ 4 vertices) as a polygon; null otherwise.
+  static std::unique_ptr<OGRPolygon> closedLineAsPolygon(const OGRGeometry* g)
+  {
+    if (wkbFlatten(g->getGeometryType()) != wkbLineString) return nullptr;
+    const OGRLineString* ls = g->toLineString();
+    if (ls->getNumPoints() < 4 || !ls->get_IsClosed()) return nullptr;
+    auto ring = std::make_unique<OGRLinearRing>();
+    ring->addSubLineString(ls);
+    auto poly = std::make_unique<OGRPolygon>();
+    poly->addRingDirectly(ring.release());
+    return poly;
   }
 
   void addLinear(const std::string& id, OGRGeometry* geometry, double width, const std::string& cls)
@@ -513,6 +541,13 @@ private:
         note(id, "no geometry (nodes missing from the extract?)");
         continue;
       }
+      if (kind_ == MapSourceKind::kOsm && errors_.truncated(std::atoll(field(*f, "osm_id").c_str())) &&
+          std::string(layer->GetName()) == "lines")
+      {
+        ++r_.skipped_missing_nodes;
+        note(id, "nodes missing from the extract");
+        continue;
+      }
       if (OGRCoordinateTransformation* ct = transformFor(layer))
       {
         if (g->transform(ct) != OGRERR_NONE)
@@ -525,6 +560,8 @@ private:
       {
         if (isPolygonal(type))
           addPolygonal(id, role, g, role == Role::kBuilding ? buildingHeight(*f) : 0.0);
+        else if (std::unique_ptr<OGRPolygon> ring = closedLineAsPolygon(g))
+          addPolygonal(id, role, ring.get(), role == Role::kBuilding ? buildingHeight(*f) : 0.0);
         else if (isLinear(type))
         {
           ++r_.skipped_unclosed;
@@ -539,8 +576,13 @@ private:
       else if (isPolygonal(type))
         addPolygonal(id, Role::kRoadArea, g, 0.0);
     }
-    // Ways GDAL's OSM driver dropped or truncated because nodes were missing (reported through CPLDebug).
-    r_.skipped_missing_nodes += errors_.missingNodeMessages();
+    // Ways GDAL's OSM driver dropped because their nodes were missing (reported only through CPLDebug).
+    if (errors_.discardedWays() > 0)
+    {
+      r_.skipped_missing_nodes += errors_.discardedWays();
+      note("ways", std::to_string(errors_.discardedWays()) +
+                       " ways (of any kind) discarded by the reader: fewer than 2 of their nodes in the extract");
+    }
   }
 
   template <class F>
