@@ -5,6 +5,7 @@
 add_library(map_aided_fusion_map_io
   src/map_io/map_loader.cpp
   src/map_io/projection.cpp
+  src/map_io/prior_png.cpp
 )
 target_include_directories(map_aided_fusion_map_io PUBLIC
   $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
@@ -32,3 +33,16 @@ if(CATKIN_ENABLE_TESTING)
     MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data"
     MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 endif()
+
+# ---- Benchmarks -----------------------------------------------------------------------------------
+if(TARGET bench_map_aided_fusion)
+  target_sources(bench_map_aided_fusion PRIVATE bench/bench_prior_grid.cpp)
+  target_link_libraries(bench_map_aided_fusion map_aided_fusion_map_io)
+  target_compile_definitions(bench_map_aided_fusion PRIVATE
+    MAF_PRIOR_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data")
+endif()
+
+# ---- Command-line tool (ROS-free) -----------------------------------------------------------------
+add_executable(prior_grid_tool src/tools/prior_grid_tool.cpp)
+target_link_libraries(prior_grid_tool map_aided_fusion_map_io)
+install(TARGETS prior_grid_tool RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
