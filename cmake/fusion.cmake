@@ -15,3 +15,15 @@ install(TARGETS map_aided_fusion_fusion_nodelet fusion_node
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(test_fusion_ros test/ros/test_visualization.cpp test/test_main.cpp)
+  target_link_libraries(test_fusion_ros map_aided_fusion_fusion_nodelet)
+
+  add_rostest_gtest(test_fusion_pipeline test/fusion_pipeline.test test/ros/test_fusion_pipeline.cpp)
+  target_link_libraries(test_fusion_pipeline ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+endif()
+
+if(TARGET bench_map_aided_fusion)
+  target_sources(bench_map_aided_fusion PRIVATE bench/bench_map_grid.cpp)
+endif()

@@ -300,6 +300,29 @@ MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumSc
   return r;
 }
 
+/// BetP of each element of Ω_MG (F, C, N, S, V); uniform where m(∅) = 1.
+template <typename T>
+MAF_INLINE void pignistic(const T (&m)[kSubsets], T (&p)[FrameMG::kSize])
+{
+  MAF_UNROLL
+  for (int e = 0; e < FrameMG::kSize; ++e) p[e] = T{};
+  MAF_UNROLL
+  for (int a = 1; a < kSubsets; ++a)
+  {
+    const T share = m[a] * (1.0f / cardinality(static_cast<Subset>(a)));
+    MAF_UNROLL
+    for (int e = 0; e < FrameMG::kSize; ++e)
+      if (a & (1 << e)) p[e] += share;
+  }
+  const T one = splat<T>(1.0f), zero{};
+  const T norm = one - m[0];
+  const auto none = norm <= zero;
+  const T inv = select(none, zero, one / norm);
+  const T uniform = select(none, splat<T>(1.0f / FrameMG::kSize), zero);
+  MAF_UNROLL
+  for (int e = 0; e < FrameMG::kSize; ++e) p[e] = p[e] * inv + uniform;
+}
+
 /// Mass on the non-empty subsets of {C, N, S, V}.
 template <typename T>
 MAF_INLINE T occupiedMass(const T (&m)[kSubsets])

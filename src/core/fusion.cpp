@@ -41,6 +41,7 @@ struct StepInputs
   const float* pt;
   float delta_inc, delta_dec, gamma_occupied, gamma_conflict, threshold;
   bool literal;
+  float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
 };
 
 template <bool kHasPrior>
@@ -70,6 +71,13 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     kernels::specialise(m, z, in.literal);
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
+    if (in.betp[0])
+    {
+      T p[FrameMG::kSize];
+      kernels::pignistic(m, p);
+      MAF_UNROLL
+      for (int e = 0; e < FrameMG::kSize; ++e) kernels::store(in.betp[e] + i, p[e]);
+    }
     sum_fo += kernels::horizontalSum(c.free_occupied);
     sum_of += kernels::horizontalSum(c.occupied_free);
     sum_other += kernels::horizontalSum(c.other);
@@ -84,7 +92,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
 
 MAF_TARGET_CLONES
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
-                FusionStepStats* stats)
+                FusionStepStats* stats, PignisticPlanes* betp)
 {
   params.validate();
   if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
@@ -108,6 +116,11 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   in.gamma_conflict = static_cast<float>(params.counter.gamma_conflict);
   in.threshold = static_cast<float>(kTotalConflictThreshold);
   in.literal = params.counter.mode == SpecialisationMode::kLiteral;
+  for (int e = 0; e < FrameMG::kSize; ++e)
+  {
+    if (betp) betp->p[e].resize(in.cells);
+    in.betp[e] = betp ? betp->p[e].data() : nullptr;
+  }
   FusionStepStats local;
   if (prior)
     fusionLoop<true>(in, w, local);

@@ -183,25 +183,16 @@ void pignisticGrid(const MapMassGrid& grid, PignisticPlanes& out)
   float* __restrict p4 = out.p[4].data();
   kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
-    T acc[FrameMG::kSize] = {};
+    T m[kSubsets];
     MAF_UNROLL
-    for (int a = 1; a < kSubsets; ++a)
-    {
-      const T share = kernels::load<T>(base + a * stride + i) * (1.0f / cardinality(static_cast<Subset>(a)));
-      MAF_UNROLL
-      for (int e = 0; e < FrameMG::kSize; ++e)
-        if (a & (1 << e)) acc[e] += share;
-    }
-    const T one = kernels::splat<T>(1.0f), zero{};
-    const T norm = one - kernels::load<T>(base + i);
-    const auto none = norm <= zero;
-    const T inv = kernels::select(none, zero, one / norm);
-    const T uniform = kernels::select(none, kernels::splat<T>(1.0f / FrameMG::kSize), zero);
-    kernels::store(p0 + i, acc[0] * inv + uniform);
-    kernels::store(p1 + i, acc[1] * inv + uniform);
-    kernels::store(p2 + i, acc[2] * inv + uniform);
-    kernels::store(p3 + i, acc[3] * inv + uniform);
-    kernels::store(p4 + i, acc[4] * inv + uniform);
+    for (int a = 0; a < kSubsets; ++a) m[a] = kernels::load<T>(base + a * stride + i);
+    T p[FrameMG::kSize];
+    kernels::pignistic(m, p);
+    kernels::store(p0 + i, p[0]);
+    kernels::store(p1 + i, p[1]);
+    kernels::store(p2 + i, p[2]);
+    kernels::store(p3 + i, p[3]);
+    kernels::store(p4 + i, p[4]);
   });
 }
 

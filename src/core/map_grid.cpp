@@ -49,6 +49,7 @@ void MapGridParams::validate() const
     throw ParameterError("size_y", "more than " + std::to_string(kMaxWindowCells) + " cells at this resolution");
   if (std::lround(size_x / resolution) < 1) throw ParameterError("size_x", "smaller than one cell");
   if (std::lround(size_y / resolution) < 1) throw ParameterError("size_y", "smaller than one cell");
+  requireInRange("recentre_distance", recentre_distance, 0.0, 0.5 * std::min(size_x, size_y));
   requireUnit("decision_threshold", decision_threshold);
   if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
   fusion.validate();
@@ -56,23 +57,43 @@ void MapGridParams::validate() const
 
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)
 {
-  if (out.geometry() != window)
-    out.reset(window);
-  else
-    out.fillVacuous();
+  if (out.geometry() != window) out.reset(window);
   const GridGeometry& sg = scan.geometry();
+  float* dst[FrameSG::kNumSubsets];
+  const float* src[FrameSG::kNumSubsets];
+  for (int a = 0; a < FrameSG::kNumSubsets; ++a)
+  {
+    dst[a] = out.plane(static_cast<Subset>(a));
+    src[a] = scan.plane(static_cast<Subset>(a));
+  }
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   // Inverse mapping: window cell centre → vehicle frame → scan cell.
   for (int y = 0; y < window.height; ++y)
   {
     const Point2 first = window.cellCentre(CellIndex{ 0, y });
     const double dx = first.x - pose.x, dy = first.y - pose.y;
-    double vx = c * dx + s * dy, vy = -s * dx + c * dy;
+    const double vx = c * dx + s * dy, vy = -s * dx + c * dy;
     const double step_x = c * window.resolution, step_y = -s * window.resolution;
-    for (int x = 0; x < window.width; ++x, vx += step_x, vy += step_y)
+    const double inv_res = 1.0 / sg.resolution;
+    double fx = (vx - sg.origin_x) * inv_res, fy = (vy - sg.origin_y) * inv_res;
+    const double dfx = step_x * inv_res, dfy = step_y * inv_res;
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(window.width);
+    for (int x = 0; x < window.width; ++x, fx += dfx, fy += dfy)
     {
-      CellIndex sc;
-      if (sg.worldToCell(Point2{ vx, vy }, sc)) copyCell(scan, sg.index(sc), out, window.index(x, y));
+      const std::size_t j = row + static_cast<std::size_t>(x);
+      if (fx >= 0.0 && fy >= 0.0 && fx < sg.width && fy < sg.height)
+      {
+        const std::size_t i = static_cast<std::size_t>(fy) * static_cast<std::size_t>(sg.width) + static_cast<std::size_t>(fx);
+        dst[0][j] = src[0][i];
+        dst[1][j] = src[1][i];
+        dst[2][j] = src[2][i];
+        dst[3][j] = src[3][i];
+      }
+      else
+      {
+        dst[0][j] = dst[1][j] = dst[2][j] = 0.0f;
+        dst[3][j] = 1.0f;
+      }
     }
   }
   // Forward pass: every occupied scan cell marks the window cell under its centre.
@@ -91,8 +112,9 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
 
 void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out)
 {
-  if (out.geometry != window || out.building.size() != window.numCells())
+  if (out.building.size() != window.numCells())
     out.reset(window);
+  out.geometry = window;
   std::vector<int> column(static_cast<std::size_t>(window.width));
   for (int x = 0; x < window.width; ++x)
   {
@@ -127,13 +149,20 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
   const std::size_t n = grid.numCells();
   out.resize(n);
   const float* omega = grid.plane(FrameMG::kOmega);
+  const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
+  const float t = static_cast<float>(threshold);
   for (std::size_t i = 0; i < n; ++i)
   {
-    int best = 0;
+    float best_p = p[0][i];
+    std::int8_t best = 0;
     for (int e = 1; e < FrameMG::kSize; ++e)
-      if (betp[e][i] > betp[best][i]) best = e;
-    const bool known = omega[i] < 1.0f - kVacuousTolerance && betp[best][i] >= threshold;
-    out[i] = known ? static_cast<std::int8_t>(best) : static_cast<std::int8_t>(CellClass::kUnknown);
+    {
+      const bool better = p[e][i] > best_p;
+      best_p = better ? p[e][i] : best_p;
+      best = better ? static_cast<std::int8_t>(e) : best;
+    }
+    const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
+    out[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
   }
 }
 
@@ -229,6 +258,7 @@ void MapGrid::setParams(const MapGridParams& params)
   if (realloc)
   {
     grid_.reset(g);
+    pignisticGrid(grid_, betp_);
     scans_ = 0;
   }
 }
@@ -236,6 +266,7 @@ void MapGrid::setParams(const MapGridParams& params)
 void MapGrid::reset()
 {
   grid_.fillVacuous();
+  pignisticGrid(grid_, betp_);
   scans_ = 0;
   last_stamp_ = 0.0;
 }
@@ -298,7 +329,10 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   }
   else
   {
-    recentre(Point2{ pose.x, pose.y });
+    const GridGeometry& g = grid_.geometry();
+    const double cx = g.origin_x + 0.5 * g.sizeX(), cy = g.origin_y + 0.5 * g.sizeY();
+    if (std::max(std::abs(pose.x - cx), std::abs(pose.y - cy)) > params_.recentre_distance)
+      recentre(Point2{ pose.x, pose.y });
   }
   t.shift = secondsSince(t0);
 
@@ -314,7 +348,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   FusionParams fp = params_.fusion;
   if (params_.rates_per_second && scans_ > 0) fp.discount = fp.discount.compounded(std::max(0.0, stamp - last_stamp_));
   FusionStepStats stats;
-  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats);
+  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_);
   t.fusion = secondsSince(t0);
 
   last_stamp_ = stamp;

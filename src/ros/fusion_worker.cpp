@@ -232,8 +232,7 @@ void FusionWorker::publish(const std_msgs::Header& header)
   bool need_betp = decision_pub_.getNumSubscribers() + cells_pub_.getNumSubscribers() + objects_pub_.getNumSubscribers() > 0;
   for (const auto& p : betp_pub_) need_betp = need_betp || p.getNumSubscribers() > 0;
   if (!need_betp) return;
-  core::PignisticPlanes betp;
-  core::pignisticGrid(grid, betp);
+  const core::PignisticPlanes& betp = grid_.pignistic();
   for (int e = 0; e < core::FrameMG::kSize; ++e)
   {
     if (betp_pub_[e].getNumSubscribers() == 0) continue;

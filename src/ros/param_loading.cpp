@@ -21,6 +21,7 @@ core::MapGridParams loadMapGridParams(const ros::NodeHandle& nh)
   readParam(nh, "size_x", p.size_x);
   readParam(nh, "size_y", p.size_y);
   readParam(nh, "resolution", p.resolution);
+  readParam(nh, "recentre_distance", p.recentre_distance);
   readParam(nh, "alpha_static", p.fusion.discount.alpha_static);
   readParam(nh, "alpha_dynamic", p.fusion.discount.alpha_dynamic);
   readParam(nh, "alpha_free", p.fusion.discount.alpha_free);

@@ -70,6 +70,9 @@ Outputs outputs(const MapGrid& mg)
 {
   Outputs o;
   pignisticGrid(mg.masses(), o.betp);
+  for (int e = 0; e < FrameMG::kSize; ++e)
+    for (std::size_t i = 0; i < mg.masses().numCells(); ++i)
+      EXPECT_NEAR(mg.pignistic()[e][i], o.betp[e][i], 1e-6) << "BetP computed in the fusion pass differs";
   decide(mg.masses(), o.betp, mg.params().decision_threshold, o.decision);
   return o;
 }
@@ -315,7 +318,9 @@ TEST(MapGridScene, BuildingIsCWithPriorAndAmbiguousWithout)
 
 TEST(MapGrid, FollowsTheVehicleByWholeCells)
 {
-  MapGrid mg(defaultParams());
+  MapGridParams params = defaultParams();
+  params.recentre_distance = 0.0;
+  MapGrid mg(params);
   mg.update(scriptedScan({}), Pose2{ 0.0, 0.0, 0.0 }, 0.0, nullptr);
   const auto g0 = mg.geometry();
   mg.update(scriptedScan({}), Pose2{ 3.3, -1.1, 0.2 }, 0.1, nullptr);
@@ -326,6 +331,15 @@ TEST(MapGrid, FollowsTheVehicleByWholeCells)
   EXPECT_NEAR(g1.origin_x + 0.5 * g1.sizeX(), 3.3, kRes);
   EXPECT_NEAR(g1.origin_y + 0.5 * g1.sizeY(), -1.1, kRes);
   EXPECT_EQ(mg.scans(), 2u);
+  // With slack, the window stays put until the vehicle is farther than recentre_distance from its centre.
+  params.recentre_distance = 4.0;
+  MapGrid lazy(params);
+  lazy.update(scriptedScan({}), Pose2{}, 0.0, nullptr);
+  const auto l0 = lazy.geometry();
+  lazy.update(scriptedScan({}), Pose2{ 3.9, -3.9, 0.0 }, 0.1, nullptr);
+  EXPECT_EQ(lazy.geometry(), l0);
+  lazy.update(scriptedScan({}), Pose2{ 4.2, 0.0, 0.0 }, 0.2, nullptr);
+  EXPECT_NEAR(lazy.geometry().origin_x + 0.5 * lazy.geometry().sizeX(), 4.2, kRes);
   mg.reset();
   EXPECT_EQ(mg.scans(), 0u);
 }

@@ -12,6 +12,7 @@
 
 #include "map_aided_fusion/core/counter.hpp"
 #include "map_aided_fusion/core/discounting.hpp"
+#include "map_aided_fusion/core/grid_ops.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
 #include "map_aided_fusion/core/prior.hpp"
 #include "map_aided_fusion/core/rules.hpp"
@@ -64,10 +65,11 @@ struct FusionStepStats
  * @param map    the MapGrid m'_MG,t−1 with its counter; becomes m'_MG,t.
  * @param scan   the ScanGrid already in @p map's cells (same geometry).
  * @param prior  the prior window of the same geometry, or nullptr for a vacuous prior.
+ * @param betp   when not null, receives BetP of m'_MG,t (computed in the same pass).
  * @throws std::invalid_argument when the geometries differ.
  */
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
-                FusionStepStats* stats = nullptr);
+                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr);
 
 }  // namespace core
 }  // namespace map_aided_fusion

@@ -36,6 +36,12 @@ struct MapGridParams
    * When false (the paper) they are per scan.
    */
   bool rates_per_second = false;
+  /**
+   * The window is recentred (whole-cell shift of all planes) once the vehicle is farther than this from its
+   * centre, metres (≥ 0; 0: every scan). Shifting moves every plane, so a few metres of slack saves most of
+   * that memory traffic while the vehicle always keeps at least size/2 − recentre_distance of view.
+   */
+  double recentre_distance = 5.0;
   double decision_threshold = 0.4;  ///< BetP a class needs to be a cell's decision, in [0, 1]
   int min_object_cells = 3;         ///< smaller connected S or V regions are noise (cells, ≥ 1)
   /// @throws ParameterError naming the first parameter out of range.
@@ -135,6 +141,8 @@ public:
   const MapMassGrid& masses() const { return grid_; }
   MapMassGrid& masses() { return grid_; }
   const GridGeometry& geometry() const { return grid_.geometry(); }
+  /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
+  const PignisticPlanes& pignistic() const { return betp_; }
   /// The scan of the last update, in window cells.
   const ScanMassGrid& lastScanInWindow() const { return scan_window_; }
   /// Number of scans fused since the last reset.
@@ -145,6 +153,7 @@ private:
   MapMassGrid grid_;
   ScanMassGrid scan_window_;
   PriorWindow prior_window_;
+  PignisticPlanes betp_;
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;
 };

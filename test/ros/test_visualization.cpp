@@ -1,0 +1,77 @@
+// Markers of the fusion outputs, without a ROS master.
+#include <gtest/gtest.h>
+
+#include "map_aided_fusion/ros/param_loading.hpp"
+#include "map_aided_fusion/ros/visualization.hpp"
+
+using namespace map_aided_fusion;
+using core::CellClass;
+
+TEST(Visualization, PaperColours)
+{
+  const auto f = Visualization::classColour(CellClass::kFree);
+  EXPECT_EQ(f.r + f.g + f.b, 3.0f);
+  const auto c = Visualization::classColour(CellClass::kBuilding);
+  EXPECT_EQ(c.b, 1.0f);
+  EXPECT_EQ(c.r + c.g, 0.0f);
+  const auto n = Visualization::classColour(CellClass::kInfrastructure);
+  EXPECT_EQ(n.g + n.b, 2.0f);
+  const auto s = Visualization::classColour(CellClass::kStopped);
+  EXPECT_GT(s.g, 0.5f);
+  EXPECT_EQ(s.r + s.b, 0.0f);
+  const auto v = Visualization::classColour(CellClass::kMoving);
+  EXPECT_EQ(v.r, 1.0f);
+  EXPECT_EQ(v.g + v.b, 0.0f);
+  EXPECT_EQ(Visualization::classColour(CellClass::kUnknown).a, 0.0f);
+}
+
+TEST(Visualization, OneCubeListPerClassWithACubePerCell)
+{
+  const core::GridGeometry g{ 0.5, 4, 2, 10.0, 20.0 };
+  std::vector<std::int8_t> d = { 0, 1, 2, 3, 4, 4, -1, 0 };
+  std_msgs::Header h;
+  h.frame_id = "map";
+  visualization_msgs::MarkerArray out;
+  Visualization::decisionToCells(g, d, h, false, out);
+  ASSERT_EQ(out.markers.size(), 5u);
+  EXPECT_EQ(out.markers[0].ns, "cells/free");
+  EXPECT_TRUE(out.markers[0].points.empty()) << "free cells drawn although include_free is false";
+  EXPECT_EQ(out.markers[0].action, visualization_msgs::Marker::DELETE);
+  EXPECT_EQ(out.markers[4].ns, "cells/moving");
+  ASSERT_EQ(out.markers[4].points.size(), 2u);
+  EXPECT_DOUBLE_EQ(out.markers[4].points[0].x, 10.25);
+  EXPECT_DOUBLE_EQ(out.markers[4].points[0].y, 20.75);
+  EXPECT_DOUBLE_EQ(out.markers[4].points[1].x, 10.75);
+  EXPECT_DOUBLE_EQ(out.markers[4].scale.x, 0.5);
+  Visualization::decisionToCells(g, d, h, true, out);
+  EXPECT_EQ(out.markers[0].points.size(), 2u);
+}
+
+TEST(Visualization, ObjectsAreBoxesWithLabels)
+{
+  core::GridObject car;
+  car.cell_class = CellClass::kMoving;
+  car.centroid = core::Point2{ 3.0, 4.0 };
+  car.yaw = M_PI / 2;
+  car.length = 4.5;
+  car.width = 2.0;
+  car.mean_betp = 0.8;
+  core::GridObject bus = car;
+  bus.cell_class = CellClass::kStopped;
+  bus.mean_betp = 0.645;
+  std_msgs::Header h;
+  h.frame_id = "map";
+  visualization_msgs::MarkerArray out;
+  Visualization::objectsToMarkers({ car, bus }, h, 1.5, out);
+  ASSERT_EQ(out.markers.size(), 5u);
+  EXPECT_EQ(out.markers[0].action, visualization_msgs::Marker::DELETEALL);
+  const auto& box = out.markers[1];
+  EXPECT_EQ(box.type, visualization_msgs::Marker::CUBE);
+  EXPECT_DOUBLE_EQ(box.pose.position.x, 3.0);
+  EXPECT_DOUBLE_EQ(box.scale.x, 4.5);
+  EXPECT_NEAR(box.pose.orientation.z, std::sqrt(0.5), 1e-12);
+  EXPECT_EQ(out.markers[2].type, visualization_msgs::Marker::TEXT_VIEW_FACING);
+  EXPECT_EQ(out.markers[2].text, "moving 0.80");
+  EXPECT_EQ(out.markers[4].text, "stopped 0.65");
+  EXPECT_NE(out.markers[1].id, out.markers[3].id);
+}
