@@ -1,0 +1,47 @@
+# ScanGrid component: lidar PointCloud2 -> evidential grid of masses on {F, O}.
+# Included from CMakeLists.txt after the core, the ROS layer and the benchmark targets exist.
+
+target_sources(map_aided_fusion_core PRIVATE src/core/scan_grid.cpp)
+
+# Nodelet library (name fixed by nodelet_plugins.xml) and its worker, shared with the plain node.
+add_library(map_aided_fusion_scan_grid_nodelet
+  src/ros/point_cloud_view.cpp
+  src/ros/scan_grid_worker.cpp
+  src/ros/scan_grid_nodelet.cpp
+)
+target_link_libraries(map_aided_fusion_scan_grid_nodelet map_aided_fusion_ros map_aided_fusion_core ${catkin_LIBRARIES})
+add_dependencies(map_aided_fusion_scan_grid_nodelet ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg
+  ${catkin_EXPORTED_TARGETS})
+
+add_executable(scan_grid_node src/ros/scan_grid_node.cpp)
+target_link_libraries(scan_grid_node map_aided_fusion_scan_grid_nodelet)
+
+install(TARGETS map_aided_fusion_scan_grid_nodelet scan_grid_node
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+if(TARGET bench_map_aided_fusion)
+  target_sources(bench_map_aided_fusion PRIVATE bench/bench_scan_grid.cpp)
+endif()
+
+if(CATKIN_ENABLE_TESTING)
+  find_package(yaml-cpp REQUIRED)
+  catkin_add_gtest(test_scan_grid
+    test/core/test_scan_grid.cpp
+    test/core/test_scan_grid_real.cpp
+    test/test_main.cpp
+  )
+  target_link_libraries(test_scan_grid map_aided_fusion_core yaml-cpp)
+  target_compile_definitions(test_scan_grid PRIVATE
+    MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data")
+
+  catkin_add_gtest(test_scan_grid_ros test/ros/test_point_cloud_view.cpp test/test_main.cpp)
+  target_link_libraries(test_scan_grid_ros map_aided_fusion_scan_grid_nodelet)
+
+  add_executable(scan_grid_rostest_node EXCLUDE_FROM_ALL test/ros/scan_grid_rostest_node.cpp)
+  target_link_libraries(scan_grid_rostest_node ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+  add_dependencies(scan_grid_rostest_node ${PROJECT_NAME}_generate_messages_cpp)
+  add_dependencies(tests scan_grid_rostest_node)
+  add_rostest(test/scan_grid.test DEPENDENCIES scan_grid_rostest_node map_aided_fusion_scan_grid_nodelet)
+endif()

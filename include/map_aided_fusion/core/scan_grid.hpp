@@ -1,0 +1,189 @@
+/**
+ * @file scan_grid.hpp
+ * @brief The ScanGrid sensor model (paper section 2.2, after Moras et al. 2010/2011): one lidar scan →
+ *        masses m(F), m(O), m(Ω) per cell of a grid in the vehicle frame (`base_link`).
+ *
+ * Polar model, per azimuth sector seen from the sensor's position:
+ * - every **obstacle** return (height above the ground within the obstacle band) marks its own cell
+ *   occupied, m(O) = μ_O, so thin obstacles never vanish between sectors or cells;
+ * - the nearest obstacle return of a sector bounds the free space of that sector: cells of the sector
+ *   closer than it get m(F) = μ_F(r); cells beyond it stay unknown (m(Ω) = 1);
+ * - **ground** returns (|z − ground| ≤ tolerance) are evidence of free space up to their range, when
+ *   they are closer than the sector's nearest obstacle;
+ * - returns above the clearance height (canopies, bridges), below the ground band, or in the gap
+ *   between the ground band and the obstacle band are neither;
+ * - invalid returns (NaN/inf, the (0, 0, 0) "no return" point, horizontal range outside
+ *   [min_range, max_range]) are never obstacles and are counted in ScanGridStats.
+ *
+ * The Cartesian grid samples the polar model at each cell centre; the cell → (sector, range, μ_F(r))
+ * table is computed once per (parameters, geometry, sensor position), not per scan.
+ * ROS-free: Eigen and the standard library only.
+ */
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "map_aided_fusion/core/grid_geometry.hpp"
+#include "map_aided_fusion/core/mass_grid.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+/// Parameters of the ScanGrid sensor model and of its grid; names as in config/scan_grid.yaml.
+struct ScanGridParams
+{
+  // Grid (vehicle frame, base_link), centred on (grid_offset_x, grid_offset_y).
+  double grid_resolution = 0.5;  ///< cell side, m (> 0); the paper's 0.5 m
+  double grid_size_x = 100.0;    ///< extent along x, m (≥ one cell)
+  double grid_size_y = 100.0;    ///< extent along y, m (≥ one cell)
+  double grid_offset_x = 0.0;    ///< x of the grid centre in base_link, m
+  double grid_offset_y = 0.0;    ///< y of the grid centre in base_link, m
+
+  // Polar model.
+  double azimuth_resolution_deg = 0.25;  ///< width of an azimuth sector, degrees, in [0.01, 45]
+  double min_range = 1.0;                ///< horizontal range below which a return is rejected, m (≥ 0)
+  double max_range = 80.0;               ///< horizontal range beyond which a return is rejected, m (> min_range)
+
+  // Heights in base_link.
+  double ground_height = 0.0;        ///< z of the ground surface in base_link, m
+  double ground_tolerance = 0.2;     ///< a return with |z − ground_height| ≤ this is ground, m (≥ 0)
+  double obstacle_min_height = 0.3;  ///< lowest obstacle return above the ground, m (≥ ground_tolerance)
+  double obstacle_max_height = 2.5;  ///< clearance: returns higher above the ground are ignored, m (> obstacle_min_height)
+
+  // Masses.
+  double mu_free = 0.7;              ///< μ_F: free mass between the sensor and a return, in [0, 1]
+  double mu_occupied = 0.8;          ///< μ_O: occupied mass of a cell holding an obstacle return, in [0, 1]
+  double free_decay_length = 0.0;    ///< μ_F(r) = μ_F·exp(−r / L), m; 0 disables the decay (≥ 0)
+
+  /// The grid described by the grid_* parameters.
+  GridGeometry geometry() const
+  {
+    return GridGeometry::centred(grid_size_x, grid_size_y, grid_resolution, grid_offset_x, grid_offset_y);
+  }
+
+  /// @throws ParameterError naming the first out-of-range parameter.
+  void validate() const;
+};
+
+/// Largest grid the builder accepts (cells), to refuse absurd sizes before allocating.
+constexpr std::size_t kScanGridMaxCells = std::size_t(1) << 26;
+
+/**
+ * @brief A read-only view of points stored as interleaved records (a sensor_msgs/PointCloud2 buffer or
+ *        any array of structs): no copy. Point (row r, column c) starts at
+ *        `data + r * row_step + c * point_step`; x, y, z are native-endian float32 at the given offsets.
+ */
+struct PointCloudView
+{
+  const std::uint8_t* data = nullptr;  ///< first byte of the first point
+  std::size_t width = 0;               ///< points per row (all points when unorganized)
+  std::size_t height = 1;              ///< rows (1 when unorganized)
+  std::size_t point_step = 0;          ///< bytes between two points of a row
+  std::size_t row_step = 0;            ///< bytes between two rows (≥ width · point_step)
+  std::size_t x_offset = 0;            ///< byte offset of float32 x in a point
+  std::size_t y_offset = 4;            ///< byte offset of float32 y in a point
+  std::size_t z_offset = 8;            ///< byte offset of float32 z in a point
+
+  std::size_t size() const { return width * height; }
+
+  /// A view of @p count packed records of @p point_step bytes with x, y, z at offsets 0, 4, 8 (default).
+  static PointCloudView packed(const void* data, std::size_t count, std::size_t point_step,
+                               std::size_t x_offset = 0, std::size_t y_offset = 4, std::size_t z_offset = 8);
+
+  /// True when the offsets fit in a point, row_step covers a row and data is set (or the view is empty).
+  bool consistent() const;
+};
+
+/// Counts of one build. rejected() = invalid returns; the others are valid returns by class.
+struct ScanGridStats
+{
+  std::size_t points = 0;               ///< points in the view
+  std::size_t non_finite = 0;           ///< NaN or inf coordinate
+  std::size_t no_return = 0;            ///< exactly (0, 0, 0) in the sensor frame
+  std::size_t below_min_range = 0;      ///< horizontal range < min_range
+  std::size_t beyond_max_range = 0;     ///< horizontal range > max_range
+  std::size_t ground = 0;               ///< ground returns
+  std::size_t obstacle = 0;             ///< obstacle returns
+  std::size_t obstacle_outside_grid = 0;///< obstacle returns outside the grid (still bound free space)
+  std::size_t below_ground = 0;         ///< below the ground band (neither)
+  std::size_t height_gap = 0;           ///< between the ground band and the obstacle band (neither)
+  std::size_t above_clearance = 0;      ///< above obstacle_max_height (neither)
+  std::size_t occupied_cells = 0;       ///< cells with m(O) = μ_O
+  std::size_t free_cells = 0;           ///< cells with m(F) > 0
+
+  std::size_t rejected() const { return non_finite + no_return + below_min_range + beyond_max_range; }
+};
+
+/**
+ * @brief Builds ScanGrids. configure() precomputes the cell → (sector, range, μ_F) table; build() then
+ *        only bins the points and fills the grid. Not thread-safe (keeps scratch buffers); one per thread.
+ */
+class ScanGridBuilder
+{
+public:
+  ScanGridBuilder() = default;
+  /// Same as configure().
+  ScanGridBuilder(const ScanGridParams& params, const Eigen::Isometry3d& sensor_pose);
+
+  /**
+   * @brief Sets the parameters and the sensor's pose in base_link (sensor → base_link). The table is
+   *        recomputed only when the grid, the sectors, the ranges, μ_F, the decay or the sensor's
+   *        (x, y) changed (by more than 1 mm; smaller moves keep the polar centre of the table).
+   * @throws ParameterError (parameters, or a grid above kScanGridMaxCells), leaving the builder unchanged.
+   */
+  void configure(const ScanGridParams& params, const Eigen::Isometry3d& sensor_pose);
+
+  /// Changes only the sensor pose (recomputes the table when its (x, y) moved).
+  void setSensorPose(const Eigen::Isometry3d& sensor_pose);
+
+  /**
+   * @brief Fills @p grid (reset to geometry() when its geometry differs) from @p points, given in the
+   *        sensor frame. Writes m(∅) = 0, m(F), m(O), m(Ω) of every cell; the counter plane is left as is.
+   *        An empty view gives an all-Ω grid.
+   * @return false (grid untouched, stats.points set) when the builder is not configured or the view is
+   *         not consistent().
+   */
+  bool build(const PointCloudView& points, ScanMassGrid& grid, ScanGridStats* stats = nullptr);
+
+  bool configured() const { return configured_; }
+  const ScanGridParams& params() const { return params_; }
+  const GridGeometry& geometry() const { return geometry_; }
+  const Eigen::Isometry3d& sensorPose() const { return sensor_pose_; }
+  int numSectors() const { return num_sectors_; }
+  /// Azimuth sector (in [0, numSectors())) of a direction (dx, dy) from the sensor, as used by the table.
+  int sectorOf(double dx, double dy) const;
+  /// How many times the table was computed (for tests: it must not be per scan).
+  std::size_t tableBuilds() const { return table_builds_; }
+
+private:
+  void buildTable();
+
+  ScanGridParams params_;
+  GridGeometry geometry_;
+  Eigen::Isometry3d sensor_pose_ = Eigen::Isometry3d::Identity();
+  bool configured_ = false;
+  int num_sectors_ = 0;
+  float sector_scale_ = 0.0f;
+  std::size_t table_builds_ = 0;
+  double table_sensor_x_ = 0.0;  // sensor position the table was computed for
+  double table_sensor_y_ = 0.0;
+
+  // Table, one entry per cell.
+  std::vector<std::uint16_t> cell_sector_;
+  AlignedVector<float> cell_range_;
+  AlignedVector<float> cell_free_;
+
+  // Scratch, reused between scans.
+  std::vector<float> sector_obstacle_;
+  std::vector<float> sector_free_;
+  std::vector<std::uint32_t> ground_hits_;  // sector of each ground return, packed with ground_range_
+  std::vector<float> ground_range_;
+  std::vector<std::uint32_t> occupied_cells_;
+};
+
+}  // namespace core
+}  // namespace map_aided_fusion

@@ -1,0 +1,115 @@
+/**
+ * @file scan_grid_worker.hpp
+ * @brief The ScanGrid node's worker, shared by ScanGridNodelet and the plain scan_grid_node.
+ *
+ * Subscribes `points` (sensor_msgs/PointCloud2 with float32 x, y, z in any layout), waits with a
+ * tf2_ros::MessageFilter until base_frame ← cloud frame is known at the cloud's stamp, builds the
+ * ScanGrid (core::ScanGridBuilder) and publishes `scan_grid` (map_aided_fusion/EvidentialGrid, classes
+ * [F, O], frame base_frame, stamp = cloud stamp; zero-copy inside a nodelet manager) and
+ * `scan_grid/occupancy` (nav_msgs/OccupancyGrid, round(100·BetP(O)), −1 where vacuous).
+ * Unreadable clouds are rejected with one error per reason, then counted; diagnostic_updater reports
+ * the input rate, the processing time and the rejected clouds and points.
+ */
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "map_aided_fusion/ScanGridConfig.h"
+#include "map_aided_fusion/core/scan_grid.hpp"
+
+namespace map_aided_fusion {
+
+/// Everything the node reads from its private namespace (config/scan_grid.yaml).
+struct ScanGridNodeParams
+{
+  std::string base_frame = "base_link";  ///< frame of the published grids
+  int input_queue_size = 2;              ///< clouds buffered by the subscriber (≥ 1)
+  int tf_queue_size = 10;                ///< clouds waiting for their transform (≥ 1)
+  double diagnostic_period = 1.0;        ///< s between diagnostic reports (> 0)
+  core::ScanGridParams model;            ///< sensor model and grid, see core::ScanGridParams
+
+  /// @throws core::ParameterError naming the first bad parameter.
+  void validate() const;
+  /**
+   * @brief Reads every parameter from @p pnh, keeping the defaults above for absent ones.
+   * @throws core::ParameterError for a parameter of the wrong type or out of range.
+   */
+  static ScanGridNodeParams load(const ros::NodeHandle& pnh);
+};
+
+/// Counters since start, reported by the diagnostics.
+struct ScanGridNodeCounters
+{
+  std::size_t clouds_received = 0;
+  std::size_t clouds_published = 0;
+  std::size_t clouds_rejected = 0;    ///< unreadable, no transform, or bad transform
+  std::size_t clouds_skipped = 0;     ///< nobody subscribed
+  std::size_t points_rejected = 0;    ///< invalid returns in processed clouds (see core::ScanGridStats)
+  std::map<std::string, std::size_t> rejections;  ///< clouds rejected, by reason
+};
+
+/// The ScanGrid node. Construct it with the node's public and private handles; it runs until destroyed.
+class ScanGridWorker
+{
+public:
+  ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~ScanGridWorker();
+  ScanGridWorker(const ScanGridWorker&) = delete;
+  ScanGridWorker& operator=(const ScanGridWorker&) = delete;
+
+  /// False when the parameters were rejected: the worker then subscribes and publishes nothing.
+  bool active() const { return active_; }
+
+private:
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud);
+  void onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr& cloud);
+  void onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& cloud,
+                          tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  void onReconfigure(ScanGridConfig& config, std::uint32_t level);
+  void reject(const std::string& reason, const std::string& detail);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  ros::NodeHandle nh_, pnh_;
+  ScanGridNodeParams params_;
+  bool active_ = false;
+
+  std::mutex mutex_;
+  core::ScanGridBuilder builder_;
+  core::ScanMassGrid grid_;
+  ScanGridNodeCounters counters_;
+  std::set<std::string> reported_;  // rejection reasons already logged as errors
+
+  // Diagnostics window.
+  std::size_t window_clouds_ = 0;
+  std::size_t window_rejected_ = 0;
+  double window_processing_sum_ = 0.0;
+  double window_processing_max_ = 0.0;
+  std::size_t window_processed_ = 0;
+  ros::WallTime window_start_;
+  core::ScanGridStats last_stats_;
+
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> tf_filter_;
+  std::unique_ptr<dynamic_reconfigure::Server<ScanGridConfig>> reconfigure_;
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  ros::Subscriber cloud_sub_;
+  ros::Publisher grid_pub_;
+  ros::Publisher occupancy_pub_;
+  ros::WallTimer diagnostic_timer_;
+};
+
+}  // namespace map_aided_fusion

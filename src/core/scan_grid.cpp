@@ -1,0 +1,352 @@
+#include "map_aided_fusion/core/scan_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "map_aided_fusion/core/parameters.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+namespace {
+
+constexpr double kFullTurnDeg = 360.0;
+constexpr double kMinAzimuthResolutionDeg = 0.01;
+constexpr double kMaxAzimuthResolutionDeg = 45.0;
+constexpr double kSensorMoveTolerance = 1e-3;  // m; a smaller (x, y) change keeps the table
+constexpr float kPi = 3.14159265358979323846f;
+constexpr float kHalfPi = 0.5f * kPi;
+constexpr float kTwoPi = 2.0f * kPi;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// Minimax polynomial for atan(a), a in [0, 1]; absolute error below 1e-5 rad.
+constexpr float kAtan1 = 0.99997726f;
+constexpr float kAtan3 = -0.33262347f;
+constexpr float kAtan5 = 0.19354346f;
+constexpr float kAtan7 = -0.11643287f;
+constexpr float kAtan9 = 0.05265332f;
+constexpr float kAtan11 = -0.01172120f;
+
+inline float fastAtan2(float y, float x)
+{
+  const float ax = std::fabs(x);
+  const float ay = std::fabs(y);
+  const float mx = std::max(ax, ay);
+  if (mx == 0.0f) return 0.0f;
+  const float a = std::min(ax, ay) / mx;
+  const float s = a * a;
+  float r = ((((kAtan11 * s + kAtan9) * s + kAtan7) * s + kAtan5) * s + kAtan3) * s * a + kAtan1 * a;
+  if (ay > ax) r = kHalfPi - r;
+  if (x < 0.0f) r = kPi - r;
+  return y < 0.0f ? -r : r;
+}
+
+inline int sectorIndex(float dx, float dy, float scale, int num_sectors)
+{
+  const int s = static_cast<int>((fastAtan2(dy, dx) + kPi) * scale);
+  return s >= num_sectors ? s - num_sectors : (s < 0 ? 0 : s);
+}
+
+inline float readFloat(const std::uint8_t* p)
+{
+  float v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+}  // namespace
+
+void ScanGridParams::validate() const
+{
+  requirePositive("grid_resolution", grid_resolution);
+  requireInRange("grid_size_x", grid_size_x, grid_resolution, std::numeric_limits<double>::max());
+  requireInRange("grid_size_y", grid_size_y, grid_resolution, std::numeric_limits<double>::max());
+  requireInRange("grid_offset_x", grid_offset_x, -std::numeric_limits<double>::max(),
+                 std::numeric_limits<double>::max());
+  requireInRange("grid_offset_y", grid_offset_y, -std::numeric_limits<double>::max(),
+                 std::numeric_limits<double>::max());
+  requireInRange("azimuth_resolution_deg", azimuth_resolution_deg, kMinAzimuthResolutionDeg,
+                 kMaxAzimuthResolutionDeg);
+  requireInRange("min_range", min_range, 0.0, std::numeric_limits<double>::max());
+  requirePositive("max_range", max_range);
+  if (!(max_range > min_range)) throw ParameterError("max_range", "must be > min_range");
+  requireInRange("ground_height", ground_height, -std::numeric_limits<double>::max(),
+                 std::numeric_limits<double>::max());
+  requireInRange("ground_tolerance", ground_tolerance, 0.0, std::numeric_limits<double>::max());
+  requireInRange("obstacle_min_height", obstacle_min_height, ground_tolerance, std::numeric_limits<double>::max());
+  requireInRange("obstacle_max_height", obstacle_max_height, obstacle_min_height,
+                 std::numeric_limits<double>::max());
+  if (!(obstacle_max_height > obstacle_min_height))
+    throw ParameterError("obstacle_max_height", "must be > obstacle_min_height");
+  requireUnit("mu_free", mu_free);
+  requireUnit("mu_occupied", mu_occupied);
+  requireInRange("free_decay_length", free_decay_length, 0.0, std::numeric_limits<double>::max());
+  const double cells = std::round(grid_size_x / grid_resolution) * std::round(grid_size_y / grid_resolution);
+  if (!(cells <= static_cast<double>(kScanGridMaxCells)))
+    throw ParameterError("grid_size_x", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
+                                            std::to_string(kScanGridMaxCells));
+}
+
+PointCloudView PointCloudView::packed(const void* data, std::size_t count, std::size_t point_step,
+                                      std::size_t x_offset, std::size_t y_offset, std::size_t z_offset)
+{
+  PointCloudView v;
+  v.data = static_cast<const std::uint8_t*>(data);
+  v.width = count;
+  v.height = 1;
+  v.point_step = point_step;
+  v.row_step = count * point_step;
+  v.x_offset = x_offset;
+  v.y_offset = y_offset;
+  v.z_offset = z_offset;
+  return v;
+}
+
+bool PointCloudView::consistent() const
+{
+  if (size() == 0) return true;
+  if (data == nullptr) return false;
+  const std::size_t last = std::max({ x_offset, y_offset, z_offset }) + sizeof(float);
+  if (last > point_step) return false;
+  if (height > 1 && row_step < width * point_step) return false;
+  return true;
+}
+
+ScanGridBuilder::ScanGridBuilder(const ScanGridParams& params, const Eigen::Isometry3d& sensor_pose)
+{
+  configure(params, sensor_pose);
+}
+
+void ScanGridBuilder::configure(const ScanGridParams& params, const Eigen::Isometry3d& sensor_pose)
+{
+  params.validate();
+  const GridGeometry geometry = params.geometry();
+  geometry.validate();
+  if (!sensor_pose.matrix().allFinite())
+    throw ParameterError("sensor_pose", "the sensor → base_link transform is not finite");
+
+  const bool same_table = configured_ && geometry == geometry_ &&
+                          params.azimuth_resolution_deg == params_.azimuth_resolution_deg &&
+                          params.min_range == params_.min_range && params.max_range == params_.max_range &&
+                          params.mu_free == params_.mu_free &&
+                          params.free_decay_length == params_.free_decay_length &&
+                          std::abs(sensor_pose.translation().x() - table_sensor_x_) <= kSensorMoveTolerance &&
+                          std::abs(sensor_pose.translation().y() - table_sensor_y_) <= kSensorMoveTolerance;
+  params_ = params;
+  geometry_ = geometry;
+  sensor_pose_ = sensor_pose;
+  configured_ = true;
+  if (!same_table) buildTable();
+}
+
+void ScanGridBuilder::setSensorPose(const Eigen::Isometry3d& sensor_pose)
+{
+  if (!configured_) throw ParameterError("sensor_pose", "configure() the builder first");
+  configure(params_, sensor_pose);
+}
+
+int ScanGridBuilder::sectorOf(double dx, double dy) const
+{
+  return sectorIndex(static_cast<float>(dx), static_cast<float>(dy), sector_scale_, num_sectors_);
+}
+
+void ScanGridBuilder::buildTable()
+{
+  num_sectors_ = static_cast<int>(std::ceil(kFullTurnDeg / params_.azimuth_resolution_deg - 1e-9));
+  sector_scale_ = static_cast<float>(num_sectors_) / kTwoPi;
+  const std::size_t n = geometry_.numCells();
+  cell_sector_.resize(n);
+  cell_range_.resize(n);
+  cell_free_.resize(n);
+  table_sensor_x_ = sensor_pose_.translation().x();
+  table_sensor_y_ = sensor_pose_.translation().y();
+  const double sx = table_sensor_x_;
+  const double sy = table_sensor_y_;
+  const bool decay = params_.free_decay_length > 0.0;
+  for (int y = 0; y < geometry_.height; ++y)
+    for (int x = 0; x < geometry_.width; ++x)
+    {
+      const std::size_t i = geometry_.index(x, y);
+      const Point2 c = geometry_.cellCentre(CellIndex{ x, y });
+      const double dx = c.x - sx;
+      const double dy = c.y - sy;
+      const double r = std::hypot(dx, dy);
+      cell_sector_[i] = static_cast<std::uint16_t>(sectorOf(dx, dy));
+      cell_range_[i] = r < params_.min_range ? kInfinity : static_cast<float>(r);
+      cell_free_[i] = static_cast<float>(decay ? params_.mu_free * std::exp(-r / params_.free_decay_length)
+                                               : params_.mu_free);
+    }
+  sector_obstacle_.assign(static_cast<std::size_t>(num_sectors_), kInfinity);
+  sector_free_.assign(static_cast<std::size_t>(num_sectors_), 0.0f);
+  ++table_builds_;
+}
+
+bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, ScanGridStats* stats)
+{
+  ScanGridStats st;
+  st.points = points.size();
+  if (!configured_ || !points.consistent())
+  {
+    if (stats) *stats = st;
+    return false;
+  }
+  if (grid.geometry() != geometry_ || grid.stride() == 0) grid.reset(geometry_);
+
+  std::fill(sector_obstacle_.begin(), sector_obstacle_.end(), kInfinity);
+  ground_hits_.clear();
+  ground_range_.clear();
+  occupied_cells_.clear();
+
+  const Eigen::Matrix3f rot = sensor_pose_.rotation().cast<float>();
+  // Points relative to the table's sensor position (within kSensorMoveTolerance of the current one).
+  const float shift_x = static_cast<float>(sensor_pose_.translation().x() - table_sensor_x_);
+  const float shift_y = static_cast<float>(sensor_pose_.translation().y() - table_sensor_y_);
+  const float trans_z = static_cast<float>(sensor_pose_.translation().z());
+  const float ground = static_cast<float>(params_.ground_height);
+  const float ground_lo = ground - static_cast<float>(params_.ground_tolerance);
+  const float ground_hi = ground + static_cast<float>(params_.ground_tolerance);
+  const float obstacle_lo = ground + static_cast<float>(params_.obstacle_min_height);
+  const float obstacle_hi = ground + static_cast<float>(params_.obstacle_max_height);
+  const float min2 = static_cast<float>(params_.min_range * params_.min_range);
+  const float max2 = static_cast<float>(params_.max_range * params_.max_range);
+  const float inv_res = static_cast<float>(1.0 / geometry_.resolution);
+  // Cell coordinates of a point relative to the sensor: (d + sensor − origin) / resolution.
+  const float cx0 = static_cast<float>((table_sensor_x_ - geometry_.origin_x) / geometry_.resolution);
+  const float cy0 = static_cast<float>((table_sensor_y_ - geometry_.origin_y) / geometry_.resolution);
+  const int width = geometry_.width;
+  const int height = geometry_.height;
+
+  for (std::size_t row = 0; row < points.height; ++row)
+  {
+    const std::uint8_t* p = points.data + row * points.row_step;
+    for (std::size_t col = 0; col < points.width; ++col, p += points.point_step)
+    {
+      const float px = readFloat(p + points.x_offset);
+      const float py = readFloat(p + points.y_offset);
+      const float pz = readFloat(p + points.z_offset);
+      if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz))
+      {
+        ++st.non_finite;
+        continue;
+      }
+      if (px == 0.0f && py == 0.0f && pz == 0.0f)
+      {
+        ++st.no_return;
+        continue;
+      }
+      const float dx = rot(0, 0) * px + rot(0, 1) * py + rot(0, 2) * pz + shift_x;
+      const float dy = rot(1, 0) * px + rot(1, 1) * py + rot(1, 2) * pz + shift_y;
+      const float z = rot(2, 0) * px + rot(2, 1) * py + rot(2, 2) * pz + trans_z;
+      const float r2 = dx * dx + dy * dy;
+      if (r2 < min2)
+      {
+        ++st.below_min_range;
+        continue;
+      }
+      if (r2 > max2)
+      {
+        ++st.beyond_max_range;
+        continue;
+      }
+      if (z < ground_lo)
+      {
+        ++st.below_ground;
+      }
+      else if (z <= ground_hi)
+      {
+        ++st.ground;
+        ground_hits_.push_back(static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_)));
+        ground_range_.push_back(std::sqrt(r2));
+      }
+      else if (z < obstacle_lo)
+      {
+        ++st.height_gap;
+      }
+      else if (z <= obstacle_hi)
+      {
+        ++st.obstacle;
+        const int s = sectorIndex(dx, dy, sector_scale_, num_sectors_);
+        float& nearest = sector_obstacle_[static_cast<std::size_t>(s)];
+        nearest = std::min(nearest, std::sqrt(r2));
+        const float fx = cx0 + dx * inv_res;
+        const float fy = cy0 + dy * inv_res;
+        if (fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(width) && fy < static_cast<float>(height))
+          occupied_cells_.push_back(static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)));
+        else
+          ++st.obstacle_outside_grid;
+      }
+      else
+      {
+        ++st.above_clearance;
+      }
+    }
+  }
+
+  for (std::size_t s = 0; s < sector_free_.size(); ++s)
+    sector_free_[s] = std::isinf(sector_obstacle_[s]) ? 0.0f : sector_obstacle_[s];
+  for (std::size_t k = 0; k < ground_hits_.size(); ++k)
+  {
+    const std::size_t s = ground_hits_[k];
+    const float r = ground_range_[k];
+    if (r < sector_obstacle_[s] && r > sector_free_[s]) sector_free_[s] = r;
+  }
+
+  float* const m_empty = grid.plane(FrameSG::kEmpty);
+  float* const m_f = grid.plane(FrameSG::kF);
+  float* const m_o = grid.plane(FrameSG::kO);
+  float* const m_omega = grid.plane(FrameSG::kOmega);
+  const std::size_t n = geometry_.numCells();
+  const float* const limit = sector_free_.data();
+  const std::uint16_t* const sector = cell_sector_.data();
+  const float* const range = cell_range_.data();
+  std::size_t free_cells = 0;
+  if (params_.free_decay_length > 0.0)
+  {
+    const float* const mu = cell_free_.data();
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const float f = mu[i] * static_cast<float>(range[i] < limit[sector[i]]);
+      m_f[i] = f;
+      m_o[i] = 0.0f;
+      m_omega[i] = 1.0f - f;
+      free_cells += f > 0.0f;
+    }
+  }
+  else
+  {
+    const float mu = static_cast<float>(params_.mu_free);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const bool is_free = range[i] < limit[sector[i]];
+      const float f = mu * static_cast<float>(is_free);
+      m_f[i] = f;
+      m_o[i] = 0.0f;
+      m_omega[i] = 1.0f - f;
+      free_cells += is_free;
+    }
+    if (mu <= 0.0f) free_cells = 0;
+  }
+  std::fill_n(m_empty, n, 0.0f);
+
+  const float mu_o = static_cast<float>(params_.mu_occupied);
+  std::size_t occupied = 0;
+  if (mu_o > 0.0f)
+    for (const std::uint32_t i : occupied_cells_)
+    {
+      if (m_o[i] != 0.0f) continue;
+      if (m_f[i] > 0.0f) --free_cells;
+      m_f[i] = 0.0f;
+      m_o[i] = mu_o;
+      m_omega[i] = 1.0f - mu_o;
+      ++occupied;
+    }
+  st.occupied_cells = occupied;
+  st.free_cells = free_cells;
+  if (stats) *stats = st;
+  return true;
+}
+
+}  // namespace core
+}  // namespace map_aided_fusion

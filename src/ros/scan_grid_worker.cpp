@@ -1,0 +1,302 @@
+#include "map_aided_fusion/ros/scan_grid_worker.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include <boost/make_shared.hpp>
+#include <nav_msgs/OccupancyGrid.h>
+
+#include "map_aided_fusion/EvidentialGrid.h"
+#include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/ros/conversions.hpp"
+#include "map_aided_fusion/ros/point_cloud_view.hpp"
+
+namespace map_aided_fusion {
+
+namespace {
+
+constexpr int kMaxQueueSize = 1000;
+constexpr double kMillisecondsPerSecond = 1000.0;
+
+/// Reads @p name into @p value when present; a present parameter of the wrong type is an error.
+template <class T>
+void readParam(const ros::NodeHandle& pnh, const std::string& name, T& value)
+{
+  if (!pnh.hasParam(name)) return;
+  if (!pnh.getParam(name, value))
+    throw core::ParameterError(name, "present in " + pnh.getNamespace() + " but of the wrong type");
+}
+
+Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
+{
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translate(Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z));
+  pose.rotate(Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized());
+  return pose;
+}
+
+}  // namespace
+
+void ScanGridNodeParams::validate() const
+{
+  if (base_frame.empty()) throw core::ParameterError("base_frame", "must not be empty");
+  core::requireInRange("input_queue_size", input_queue_size, 1, kMaxQueueSize);
+  core::requireInRange("tf_queue_size", tf_queue_size, 1, kMaxQueueSize);
+  core::requirePositive("diagnostic_period", diagnostic_period);
+  model.validate();
+}
+
+ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
+{
+  ScanGridNodeParams p;
+  readParam(pnh, "base_frame", p.base_frame);
+  readParam(pnh, "input_queue_size", p.input_queue_size);
+  readParam(pnh, "tf_queue_size", p.tf_queue_size);
+  readParam(pnh, "diagnostic_period", p.diagnostic_period);
+  core::ScanGridParams& m = p.model;
+  readParam(pnh, "grid_resolution", m.grid_resolution);
+  readParam(pnh, "grid_size_x", m.grid_size_x);
+  readParam(pnh, "grid_size_y", m.grid_size_y);
+  readParam(pnh, "grid_offset_x", m.grid_offset_x);
+  readParam(pnh, "grid_offset_y", m.grid_offset_y);
+  readParam(pnh, "azimuth_resolution_deg", m.azimuth_resolution_deg);
+  readParam(pnh, "min_range", m.min_range);
+  readParam(pnh, "max_range", m.max_range);
+  readParam(pnh, "ground_height", m.ground_height);
+  readParam(pnh, "ground_tolerance", m.ground_tolerance);
+  readParam(pnh, "obstacle_min_height", m.obstacle_min_height);
+  readParam(pnh, "obstacle_max_height", m.obstacle_max_height);
+  readParam(pnh, "mu_free", m.mu_free);
+  readParam(pnh, "mu_occupied", m.mu_occupied);
+  readParam(pnh, "free_decay_length", m.free_decay_length);
+  p.validate();
+  return p;
+}
+
+ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh)
+{
+  try
+  {
+    params_ = ScanGridNodeParams::load(pnh_);
+    builder_.configure(params_.model, Eigen::Isometry3d::Identity());
+  }
+  catch (const core::ParameterError& e)
+  {
+    ROS_ERROR("scan_grid: invalid parameter %s/%s; the node stays idle until restarted with valid parameters",
+              pnh_.getNamespace().c_str(), e.what());
+    return;
+  }
+  grid_.reset(builder_.geometry());
+
+  tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
+  tf_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>>(
+      *tf_buffer_, params_.base_frame, static_cast<std::uint32_t>(params_.tf_queue_size), nh_);
+  tf_filter_->registerCallback(&ScanGridWorker::onCloudWithTransform, this);
+  tf_filter_->registerFailureCallback(
+      [this](const sensor_msgs::PointCloud2ConstPtr& cloud,
+             tf2_ros::filter_failure_reasons::FilterFailureReason reason) { onTransformFailure(cloud, reason); });
+
+  updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
+  updater_->setHardwareID("scan_grid");
+  updater_->add("ScanGrid", this, &ScanGridWorker::diagnose);
+  window_start_ = ros::WallTime::now();
+  diagnostic_timer_ = nh_.createWallTimer(ros::WallDuration(params_.diagnostic_period),
+                                          [this](const ros::WallTimerEvent&) { updater_->force_update(); });
+
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ScanGridConfig>>(pnh_);
+  reconfigure_->setCallback(
+      [this](ScanGridConfig& config, std::uint32_t level) { onReconfigure(config, level); });
+
+  grid_pub_ = nh_.advertise<EvidentialGrid>("scan_grid", 1);
+  occupancy_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("scan_grid/occupancy", 1);
+  cloud_sub_ = nh_.subscribe("points", static_cast<std::uint32_t>(params_.input_queue_size), &ScanGridWorker::onCloud,
+                             this, ros::TransportHints().tcpNoDelay());
+  active_ = true;
+  const core::GridGeometry& g = builder_.geometry();
+  ROS_INFO("scan_grid: %s -> %s and %s in %s, %d x %d cells of %.2f m, %d sectors",
+           cloud_sub_.getTopic().c_str(), grid_pub_.getTopic().c_str(), occupancy_pub_.getTopic().c_str(),
+           params_.base_frame.c_str(), g.width, g.height, g.resolution, builder_.numSectors());
+}
+
+ScanGridWorker::~ScanGridWorker()
+{
+  cloud_sub_.shutdown();
+  diagnostic_timer_.stop();
+  tf_filter_.reset();
+}
+
+void ScanGridWorker::reject(const std::string& reason, const std::string& detail)
+{
+  ++counters_.clouds_rejected;
+  ++counters_.rejections[reason];
+  ++window_rejected_;
+  if (reported_.insert(reason).second)
+    ROS_ERROR("scan_grid: rejected a cloud on %s (%s): %s. Further clouds rejected for this reason are only "
+              "counted (see diagnostics).",
+              cloud_sub_.getTopic().c_str(), reason.c_str(), detail.c_str());
+  else
+    ROS_DEBUG("scan_grid: rejected a cloud (%s): %s", reason.c_str(), detail.c_str());
+}
+
+void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
+{
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counters_.clouds_received;
+    ++window_clouds_;
+    core::PointCloudView view;
+    std::string detail;
+    const CloudRejection r = makePointCloudView(*cloud, view, &detail);
+    if (r != CloudRejection::kNone)
+    {
+      reject(toString(r), detail);
+      return;
+    }
+    if (cloud->header.frame_id.empty())
+    {
+      reject("no_frame_id", "header.frame_id is empty");
+      return;
+    }
+    if (grid_pub_.getNumSubscribers() == 0 && occupancy_pub_.getNumSubscribers() == 0)
+    {
+      ++counters_.clouds_skipped;
+      return;
+    }
+  }
+  tf_filter_->add(cloud);
+}
+
+void ScanGridWorker::onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& cloud,
+                                        tf2_ros::filter_failure_reasons::FilterFailureReason reason)
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  const char* why = reason == tf2_ros::filter_failure_reasons::OutTheBack ? "older than the transform buffer" :
+                    reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame_id" :
+                                                                               "transform not available in time";
+  reject("no_transform", "no transform " + params_.base_frame + " <- " + cloud->header.frame_id + " at " +
+                             std::to_string(cloud->header.stamp.toSec()) + ": " + why);
+}
+
+void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr& cloud)
+{
+  const ros::WallTime start = ros::WallTime::now();
+  std::lock_guard<std::mutex> lock(mutex_);
+  Eigen::Isometry3d pose;
+  try
+  {
+    pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, cloud->header.frame_id, cloud->header.stamp)
+                       .transform);
+    builder_.setSensorPose(pose);
+  }
+  catch (const tf2::TransformException& e)
+  {
+    reject("no_transform", e.what());
+    return;
+  }
+  catch (const core::ParameterError& e)
+  {
+    reject("bad_transform", e.what());
+    return;
+  }
+  core::PointCloudView view;
+  std::string detail;
+  const CloudRejection r = makePointCloudView(*cloud, view, &detail);
+  if (r != CloudRejection::kNone)
+  {
+    reject(toString(r), detail);
+    return;
+  }
+  if (!builder_.build(view, grid_, &last_stats_))
+  {
+    reject("layout", "the point view is inconsistent");
+    return;
+  }
+  counters_.points_rejected += last_stats_.rejected();
+
+  std_msgs::Header header;
+  header.stamp = cloud->header.stamp;
+  header.frame_id = params_.base_frame;
+  if (grid_pub_.getNumSubscribers() > 0)
+  {
+    auto msg = boost::make_shared<EvidentialGrid>();
+    GridConversions::toMessage(grid_, header, *msg);
+    grid_pub_.publish(msg);
+  }
+  if (occupancy_pub_.getNumSubscribers() > 0)
+  {
+    auto occupancy = boost::make_shared<nav_msgs::OccupancyGrid>();
+    GridConversions::scanToOccupancy(grid_, header, *occupancy);
+    occupancy_pub_.publish(occupancy);
+  }
+  ++counters_.clouds_published;
+  const double elapsed = (ros::WallTime::now() - start).toSec();
+  window_processing_sum_ += elapsed;
+  window_processing_max_ = std::max(window_processing_max_, elapsed);
+  ++window_processed_;
+}
+
+void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level*/)
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  core::ScanGridParams m = params_.model;
+  m.azimuth_resolution_deg = config.azimuth_resolution_deg;
+  m.min_range = config.min_range;
+  m.max_range = config.max_range;
+  m.ground_height = config.ground_height;
+  m.ground_tolerance = config.ground_tolerance;
+  m.obstacle_min_height = config.obstacle_min_height;
+  m.obstacle_max_height = config.obstacle_max_height;
+  m.mu_free = config.mu_free;
+  m.mu_occupied = config.mu_occupied;
+  m.free_decay_length = config.free_decay_length;
+  try
+  {
+    builder_.configure(m, builder_.sensorPose());
+    params_.model = m;
+  }
+  catch (const core::ParameterError& e)
+  {
+    ROS_ERROR("scan_grid: reconfiguration rejected, keeping the previous parameters: %s", e.what());
+  }
+}
+
+void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  const ros::WallTime now = ros::WallTime::now();
+  const double window = std::max((now - window_start_).toSec(), std::numeric_limits<double>::min());
+  const double rate = static_cast<double>(window_clouds_) / window;
+  const double mean_ms = window_processed_ > 0 ? kMillisecondsPerSecond * window_processing_sum_ /
+                                                     static_cast<double>(window_processed_) :
+                                                 0.0;
+  if (window_rejected_ > 0)
+    status.summaryf(diagnostic_updater::DiagnosticStatusWrapper::WARN, "%zu of %zu clouds rejected", window_rejected_,
+                    window_clouds_);
+  else if (window_clouds_ == 0)
+    status.summary(diagnostic_updater::DiagnosticStatusWrapper::WARN, "no input cloud");
+  else
+    status.summaryf(diagnostic_updater::DiagnosticStatusWrapper::OK, "%.1f Hz, %.2f ms per cloud", rate, mean_ms);
+  status.add("input rate (Hz)", rate);
+  status.add("processing time mean (ms)", mean_ms);
+  status.add("processing time max (ms)", kMillisecondsPerSecond * window_processing_max_);
+  status.add("clouds received", counters_.clouds_received);
+  status.add("clouds published", counters_.clouds_published);
+  status.add("clouds rejected", counters_.clouds_rejected);
+  status.add("clouds skipped (no subscriber)", counters_.clouds_skipped);
+  for (const auto& r : counters_.rejections) status.add("clouds rejected: " + r.first, r.second);
+  status.add("points rejected", counters_.points_rejected);
+  status.add("last cloud: points", last_stats_.points);
+  status.add("last cloud: non-finite", last_stats_.non_finite);
+  status.add("last cloud: no return (0,0,0)", last_stats_.no_return);
+  status.add("last cloud: out of range", last_stats_.below_min_range + last_stats_.beyond_max_range);
+  status.add("last cloud: ground / obstacle", std::to_string(last_stats_.ground) + " / " +
+                                                  std::to_string(last_stats_.obstacle));
+  status.add("last cloud: occupied / free cells", std::to_string(last_stats_.occupied_cells) + " / " +
+                                                      std::to_string(last_stats_.free_cells));
+  window_clouds_ = window_rejected_ = window_processed_ = 0;
+  window_processing_sum_ = window_processing_max_ = 0.0;
+  window_start_ = now;
+}
+
+}  // namespace map_aided_fusion
