@@ -176,6 +176,8 @@ public:
   ErrorCapture(const ErrorCapture&) = delete;
   ErrorCapture& operator=(const ErrorCapture&) = delete;
   const std::string& last() const { return last_; }
+  /// Errors (CE_Failure or worse) reported by GDAL so far.
+  std::size_t failures() const { return failures_; }
   /// Ways the OSM driver dropped because fewer than 2 of their nodes are in the extract.
   std::size_t discardedWays() const { return discarded_ways_; }
   /// Ways the OSM driver shortened because some of their nodes are missing from the extract.
@@ -199,11 +201,13 @@ private:
       return;
     }
     self->last_ = m;
+    if (level >= CE_Failure) ++self->failures_;
   }
   std::string last_;
   std::string saved_debug_;
   bool had_debug_ = false;
   std::size_t discarded_ways_ = 0;
+  std::size_t failures_ = 0;
   std::set<long long> truncated_ways_;
 };
 
@@ -524,6 +528,19 @@ private:
 
   void readFeatures()
   {
+    const std::size_t failures_before = errors_.failures();
+    readAllFeatures();
+    r_.read_errors = errors_.failures() - failures_before;
+    if (r_.read_errors > 0)
+    {
+      if (buildings_.empty() && areas_.empty() && lines_.empty())
+        fail("read error after " + std::to_string(r_.features_read) + " features: " + errors_.last());
+      note("file", "read error (the map may be incomplete): " + errors_.last());
+    }
+  }
+
+  void readAllFeatures()
+  {
     OGRLayer* layer = nullptr;
     for (;;)
     {
@@ -807,6 +824,7 @@ std::string summary(const MapLoadReport& r)
     << r.skipped_geometries << " (unclosed " << r.skipped_unclosed << ", missing nodes " << r.skipped_missing_nodes
     << ", degenerate " << r.skipped_degenerate << ", invalid " << r.skipped_invalid << ", out of range "
     << r.skipped_out_of_range << ")";
+  if (r.read_errors > 0) s << "; " << r.read_errors << " read errors: the map may be incomplete";
   return s.str();
 }
 

@@ -127,6 +127,7 @@ struct MapLoadReport
   std::size_t skipped_degenerate = 0;      ///< fewer than 3 distinct vertices (polygons) or 2 (lines), NaN
   std::size_t skipped_invalid = 0;         ///< invalid polygons not repaired
   std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance from the origin
+  std::size_t read_errors = 0;             ///< GDAL errors while reading features (truncated file…)
   std::vector<std::string> messages;       ///< the first few skip reasons, with feature ids
 };
 
