@@ -107,6 +107,8 @@ map_io::PriorGridParams readPriorGridParams(const ros::NodeHandle& pnh)
   param(pnh, "road_width_attribute", m.road_width_attribute);
   param(pnh, "road_lanes_attribute", m.road_lanes_attribute);
   param(pnh, "road_area_attribute", m.road_area_attribute);
+  param(pnh, "road_tunnel_attribute", m.road_tunnel_attribute);
+  param(pnh, "exclude_tunnels", m.exclude_tunnels);
   param(pnh, "drivable_classes", m.drivable_classes);
   param(pnh, "lane_width", m.lane_width);
   param(pnh, "level_height", m.level_height);

@@ -380,14 +380,22 @@ TEST(MapLoader, WidthFromLanesThenClassDefault)
   <way id="12"><nd ref="1"/><nd ref="2"/><tag k="highway" v="motorway"/><tag k="width" v="24 ft"/></way>
   <way id="13"><nd ref="1"/><nd ref="2"/><tag k="highway" v="cycleway"/></way>
   <way id="14"><nd ref="1"/><nd ref="2"/><tag k="highway" v="service"/><tag k="width" v="wide"/></way>
+  <way id="15"><nd ref="1"/><nd ref="2"/><tag k="highway" v="primary"/><tag k="tunnel" v="yes"/></way>
+  <way id="16"><nd ref="1"/><nd ref="2"/><tag k="highway" v="service"/><tag k="tunnel" v="building_passage"/></way>
+  <node id="3" lat="49.0001" lon="2.0"/><node id="4" lat="49.0001" lon="2.001"/>
+  <way id="17"><nd ref="1"/><nd ref="2"/><nd ref="4"/><nd ref="3"/><nd ref="1"/><tag k="area:highway" v="footway"/></way>
 </osm>)";
   map_io::MapLoadParams p;
   p.file = writeTemp("widths.osm", osm);
   p.origin_latitude = kFixtureLat;
   p.origin_longitude = kFixtureLon;
   p.lane_width = 3.25;
-  const core::VectorMap m = map_io::loadVectorMap(p);
-  ASSERT_EQ(m.road_lines.size(), 4u);
+  map_io::MapLoadReport r;
+  const core::VectorMap m = map_io::loadVectorMap(p, &r);
+  ASSERT_EQ(m.road_lines.size(), 5u);   // 10, 11, 12, 14 and the building passage 16; not the cycleway
+  EXPECT_EQ(r.excluded_tunnels, 1u);    // 15
+  EXPECT_TRUE(m.road_areas.empty());    // an area:highway=footway pavement is not road
+  EXPECT_EQ(r.skipped_geometries, 0u);
   std::map<std::string, double> widths;
   for (const auto& l : m.road_lines) widths[l.id] = l.width;
   EXPECT_DOUBLE_EQ(widths["way/10"], 3 * 3.25);
