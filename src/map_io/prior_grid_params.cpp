@@ -27,8 +27,9 @@ namespace {
 /// Cells [c0, c1) of @p extent along one axis covering [lo, hi).
 void cellRange(double lo, double hi, double origin, double res, int n, int& c0, int& c1)
 {
-  c0 = std::clamp(static_cast<int>(std::floor((lo - origin) / res)), 0, n);
-  c1 = std::clamp(static_cast<int>(std::ceil((hi - origin) / res)), 0, n);
+  const double n_cells = static_cast<double>(n);
+  c0 = static_cast<int>(std::clamp(std::floor((lo - origin) / res), 0.0, n_cells));
+  c1 = static_cast<int>(std::clamp(std::ceil((hi - origin) / res), 0.0, n_cells));
 }
 
 }  // namespace

@@ -128,6 +128,18 @@ TEST(ScanlineRasterizer, ClipsToTheGridAndIgnoresNonFiniteRings)
   EXPECT_TRUE(spans.empty());
   r.fill(Ring{ { 0, 0 }, { 1, 1 } }, spans);
   EXPECT_TRUE(spans.empty());
+  // Absurd but finite coordinates: clamped, no overflow.
+  r.fill(Ring{ { -1e300, -1e300 }, { 1e300, -1e300 }, { 1e300, 1e300 }, { -1e300, 1e300 } }, spans);
+  EXPECT_EQ(cellsOf(spans), 1600u);
+}
+
+TEST(PriorGrid, HugeExtentIsAnError)
+{
+  VectorMap m;
+  Building b;
+  b.footprint.outer = rect(0, 0, 1e12, 1);
+  m.buildings.push_back(b);
+  EXPECT_THROW(PriorGrid::extentOf(m, 0.5), ParameterError);
 }
 
 // Crossing-number point-in-polygon with the same half-open convention.
