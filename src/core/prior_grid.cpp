@@ -204,6 +204,12 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
     }
     return !spans.empty();
   };
+  const auto overlapsGrid = [this](const Ring& r) {
+    const auto [xmin, xmax] = std::minmax_element(r.begin(), r.end(), [](auto& a, auto& b) { return a.x < b.x; });
+    const auto [ymin, ymax] = std::minmax_element(r.begin(), r.end(), [](auto& a, auto& b) { return a.y < b.y; });
+    return xmax->x >= geometry_.origin_x && xmin->x <= geometry_.origin_x + geometry_.sizeX() &&
+           ymax->y >= geometry_.origin_y && ymin->y <= geometry_.origin_y + geometry_.sizeY();
+  };
   const auto validPolygon = [](const Polygon& p) {
     if (p.outer.size() < 3 || !finiteRing(p.outer)) return false;
     return std::all_of(p.holes.begin(), p.holes.end(), finiteRing);
@@ -247,8 +253,10 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
     rasterizer.fill(b.footprint, spans);
     if (paint(PriorClass::kBuilding))
       ++st.buildings_rasterised;
-    else
+    else if (overlapsGrid(b.footprint.outer))
       ++st.buildings_empty;
+    else
+      ++st.buildings_outside;
   }
 }
 

@@ -520,6 +520,7 @@ void checkRealExtract(const std::string& name, std::size_t min_buildings, double
             << stats.buildings_rasterised << " buildings rasterised, " << stats.buildings_empty
             << " smaller than a cell" << std::endl;
   // None dropped silently: every kept building is either rasterised or counted as covering no cell centre.
+  EXPECT_EQ(stats.buildings_outside, 0u);
   EXPECT_EQ(stats.buildings_rasterised + stats.buildings_empty + stats.skipped_invalid, m.buildings.size());
   EXPECT_GE(static_cast<double>(stats.buildings_rasterised), 0.98 * static_cast<double>(m.buildings.size()));
   const auto n = grid.classCounts();
