@@ -86,6 +86,16 @@ TEST(PriorGridNodelet, BadMapIsReportedAndTheNodeletStaysAlive)
   EXPECT_FALSE(srv.response.success);
 }
 
+TEST(PriorGridNodelet, OutOfRangeParameterIsNamedAndTheNodeletStaysAlive)
+{
+  ASSERT_TRUE(ros::service::waitForService("/bad_param/prior_grid/reload", ros::Duration(kTimeout)));
+  std_srvs::Trigger srv;
+  ASSERT_TRUE(ros::service::call("/bad_param/prior_grid/reload", srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("beta_road"), std::string::npos) << srv.response.message;
+  EXPECT_TRUE(waitFor<EvidentialGrid>("/bad_param/prior_grid", 1.0) == nullptr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
