@@ -6,6 +6,7 @@ add_library(map_aided_fusion_map_io
   src/map_io/map_loader.cpp
   src/map_io/projection.cpp
   src/map_io/prior_png.cpp
+  src/map_io/prior_grid_params.cpp
 )
 target_include_directories(map_aided_fusion_map_io PUBLIC
   $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
@@ -21,17 +22,43 @@ install(TARGETS map_aided_fusion_map_io
 # ---- Core: scanline rasteriser and PriorGrid (ROS-free) ---------------------------------------
 target_sources(map_aided_fusion_core PRIVATE src/core/prior_grid.cpp)
 
+# ---- ROS: nodelet (library name fixed by nodelet_plugins.xml) and plain node -------------------------
+add_library(map_aided_fusion_prior_grid_nodelet
+  src/ros/prior_grid_node.cpp
+  src/ros/prior_grid_nodelet.cpp
+)
+target_link_libraries(map_aided_fusion_prior_grid_nodelet map_aided_fusion_ros map_aided_fusion_map_io ${catkin_LIBRARIES})
+add_dependencies(map_aided_fusion_prior_grid_nodelet ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+
+add_executable(prior_grid_node src/ros/prior_grid_node_main.cpp)
+target_link_libraries(prior_grid_node map_aided_fusion_prior_grid_nodelet)
+
+install(TARGETS map_aided_fusion_prior_grid_nodelet prior_grid_node
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
 # ---- Tests --------------------------------------------------------------------------------------
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_prior_grid test/prior/test_prior_grid.cpp test/test_main.cpp)
   target_link_libraries(test_prior_grid map_aided_fusion_core)
 
   catkin_add_gtest(test_map_loader test/prior/test_map_loader.cpp test/test_main.cpp)
-  target_link_libraries(test_map_loader map_aided_fusion_map_io ${GeographicLib_LIBRARIES})
-  target_include_directories(test_map_loader SYSTEM PRIVATE ${GeographicLib_INCLUDE_DIRS})
+  target_link_libraries(test_map_loader map_aided_fusion_map_io ${GeographicLib_LIBRARIES} ${GDAL_LIBRARIES})
+  target_include_directories(test_map_loader SYSTEM PRIVATE ${GeographicLib_INCLUDE_DIRS} ${GDAL_INCLUDE_DIRS})
   target_compile_definitions(test_map_loader PRIVATE
     MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data"
     MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+
+  catkin_add_gtest(test_prior_grid_params test/prior/test_prior_grid_params.cpp test/test_main.cpp)
+  target_link_libraries(test_prior_grid_params map_aided_fusion_map_io)
+
+  # rostest: latched prior received by a late subscriber; a bad map path is reported and the node stays alive.
+  add_executable(test_prior_grid_ros EXCLUDE_FROM_ALL test/prior/test_prior_grid_ros.cpp)
+  target_link_libraries(test_prior_grid_ros ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+  add_dependencies(test_prior_grid_ros ${PROJECT_NAME}_generate_messages_cpp)
+  add_dependencies(tests test_prior_grid_ros map_aided_fusion_prior_grid_nodelet)
+  add_rostest(test/prior_grid.test DEPENDENCIES test_prior_grid_ros map_aided_fusion_prior_grid_nodelet)
 endif()
 
 # ---- Benchmarks -----------------------------------------------------------------------------------

@@ -22,10 +22,17 @@ bool finiteRing(const Ring& r)
   return std::all_of(r.begin(), r.end(), [](const Point2& p) { return std::isfinite(p.x) && std::isfinite(p.y); });
 }
 
-/// Index of the first row/column whose centre is ≥ v (centres at origin + (i + 0.5)·res).
-inline long firstCentreAtOrAbove(double v, double origin, double res)
+/// Largest grid side in cells accepted by extentOf() (2^30, well inside int).
+constexpr double kMaxCellsPerAxis = 1073741824.0;
+
+/// Index of the first row/column whose centre is ≥ v (centres at origin + (i + 0.5)·res), clamped to
+/// [0, n] (NaN gives n: an empty range).
+inline long firstCentreAtOrAbove(double v, double origin, double res, long n)
 {
-  return static_cast<long>(std::ceil((v - origin) / res - 0.5));
+  const double c = std::ceil((v - origin) / res - 0.5);
+  if (c <= 0.0) return 0;
+  if (!(c < static_cast<double>(n))) return n;
+  return static_cast<long>(c);
 }
 
 }  // namespace
@@ -46,8 +53,8 @@ void ScanlineRasterizer::addRing(const Ring& ring)
     const Point2& b = ring[(i + 1) % n];
     if (a.y == b.y) continue;
     const double ylo = std::min(a.y, b.y), yhi = std::max(a.y, b.y);
-    const long r0 = std::max(0L, firstCentreAtOrAbove(ylo, oy, res));
-    const long r1 = std::min(static_cast<long>(geometry_.height), firstCentreAtOrAbove(yhi, oy, res));
+    const long r0 = firstCentreAtOrAbove(ylo, oy, res, geometry_.height);
+    const long r1 = firstCentreAtOrAbove(yhi, oy, res, geometry_.height);
     if (r0 >= r1) continue;
     const double slope = (b.x - a.x) / (b.y - a.y);
     for (long r = r0; r < r1; ++r)
@@ -77,8 +84,8 @@ void ScanlineRasterizer::fill(const std::vector<const Ring*>& rings, std::vector
     // Within a row the number of crossings is even (half-open rule on closed rings).
     for (std::size_t k = i; k + 1 < j; k += 2)
     {
-      const long c0 = std::max(0L, firstCentreAtOrAbove(crossings_[k].second, ox, res));
-      const long c1 = std::min(w, firstCentreAtOrAbove(crossings_[k + 1].second, ox, res));
+      const long c0 = firstCentreAtOrAbove(crossings_[k].second, ox, res, w);
+      const long c1 = firstCentreAtOrAbove(crossings_[k + 1].second, ox, res, w);
       if (c0 < c1) spans.push_back(CellSpan{ crossings_[i].first, static_cast<int>(c0), static_cast<int>(c1) });
     }
     i = j;
@@ -161,8 +168,13 @@ GridGeometry PriorGrid::extentOf(const VectorMap& map, double resolution, double
   g.resolution = resolution;
   g.origin_x = std::floor((x0 - margin) / resolution) * resolution;
   g.origin_y = std::floor((y0 - margin) / resolution) * resolution;
-  g.width = std::max(1, static_cast<int>(std::ceil((x1 + margin - g.origin_x) / resolution)));
-  g.height = std::max(1, static_cast<int>(std::ceil((y1 + margin - g.origin_y) / resolution)));
+  const double w = std::ceil((x1 + margin - g.origin_x) / resolution);
+  const double h = std::ceil((y1 + margin - g.origin_y) / resolution);
+  if (!(w <= kMaxCellsPerAxis && h <= kMaxCellsPerAxis))
+    throw ParameterError("resolution", "the map's extent (" + std::to_string(x1 - x0) + " m x " +
+                                           std::to_string(y1 - y0) + " m) is too many cells at this resolution");
+  g.width = std::max(1, static_cast<int>(w));
+  g.height = std::max(1, static_cast<int>(h));
   return g;
 }
 
@@ -191,6 +203,12 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
       std::fill(row + s.col_begin, row + s.col_end, v);
     }
     return !spans.empty();
+  };
+  const auto overlapsGrid = [this](const Ring& r) {
+    const auto [xmin, xmax] = std::minmax_element(r.begin(), r.end(), [](auto& a, auto& b) { return a.x < b.x; });
+    const auto [ymin, ymax] = std::minmax_element(r.begin(), r.end(), [](auto& a, auto& b) { return a.y < b.y; });
+    return xmax->x >= geometry_.origin_x && xmin->x <= geometry_.origin_x + geometry_.sizeX() &&
+           ymax->y >= geometry_.origin_y && ymin->y <= geometry_.origin_y + geometry_.sizeY();
   };
   const auto validPolygon = [](const Polygon& p) {
     if (p.outer.size() < 3 || !finiteRing(p.outer)) return false;
@@ -235,8 +253,10 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
     rasterizer.fill(b.footprint, spans);
     if (paint(PriorClass::kBuilding))
       ++st.buildings_rasterised;
-    else
+    else if (overlapsGrid(b.footprint.outer))
       ++st.buildings_empty;
+    else
+      ++st.buildings_outside;
   }
 }
 

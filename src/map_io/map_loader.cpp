@@ -122,10 +122,11 @@ std::string osmConfig(const MapLoadParams& p)
   c << "[points]\n" << common << "attributes=name\n";
   c << "[lines]\n" << common << "attributes=name," << p.building_attribute << "," << p.building_height_attribute
     << "," << p.building_levels_attribute << "," << p.road_class_attribute << ","
-    << p.road_width_attribute << "," << p.road_lanes_attribute << "," << p.road_area_attribute << ",area\n";
+    << p.road_width_attribute << "," << p.road_lanes_attribute << "," << p.road_area_attribute << ",area,"
+    << p.road_tunnel_attribute << "\n";
   c << "[multipolygons]\n" << common << "attributes=name,type," << p.building_attribute << ","
     << p.building_height_attribute << "," << p.building_levels_attribute << "," << p.road_class_attribute << ","
-    << p.road_area_attribute << ",area\n";
+    << p.road_area_attribute << ",area," << p.road_tunnel_attribute << "\n";
   c << "[multilinestrings]\n" << common << "attributes=name,type\n";
   c << "[other_relations]\n" << common << "attributes=name,type\n";
   return c.str();
@@ -176,6 +177,8 @@ public:
   ErrorCapture(const ErrorCapture&) = delete;
   ErrorCapture& operator=(const ErrorCapture&) = delete;
   const std::string& last() const { return last_; }
+  /// Errors (CE_Failure or worse) reported by GDAL so far.
+  std::size_t failures() const { return failures_; }
   /// Ways the OSM driver dropped because fewer than 2 of their nodes are in the extract.
   std::size_t discardedWays() const { return discarded_ways_; }
   /// Ways the OSM driver shortened because some of their nodes are missing from the extract.
@@ -199,11 +202,13 @@ private:
       return;
     }
     self->last_ = m;
+    if (level >= CE_Failure) ++self->failures_;
   }
   std::string last_;
   std::string saved_debug_;
   bool had_debug_ = false;
   std::size_t discarded_ways_ = 0;
+  std::size_t failures_ = 0;
   std::set<long long> truncated_ways_;
 };
 
@@ -323,6 +328,12 @@ private:
     return false;
   }
 
+  bool isTunnel(const OGRFeature& f) const
+  {
+    const std::string t = field(f, p_.road_tunnel_attribute);
+    return !t.empty() && t != "no" && t != "building_passage";
+  }
+
   std::string featureId(OGRLayer* layer, const OGRFeature& f) const
   {
     if (kind_ == MapSourceKind::kOsm)
@@ -362,7 +373,8 @@ private:
     }
     const std::string building = field(f, p_.building_attribute);
     if (!building.empty() && building != "no") return Role::kBuilding;
-    if (!field(f, p_.road_area_attribute).empty()) return Role::kRoadArea;
+    const std::string area_class = field(f, p_.road_area_attribute);
+    if (!area_class.empty()) return isDrivable(area_class) ? Role::kRoadArea : Role::kNone;
     const std::string cls = field(f, p_.road_class_attribute);
     if (!cls.empty() && isDrivable(cls))
     {
@@ -524,6 +536,19 @@ private:
 
   void readFeatures()
   {
+    const std::size_t failures_before = errors_.failures();
+    readAllFeatures();
+    r_.read_errors = errors_.failures() - failures_before;
+    if (r_.read_errors > 0)
+    {
+      if (buildings_.empty() && areas_.empty() && lines_.empty())
+        fail("read error after " + std::to_string(r_.features_read) + " features: " + errors_.last());
+      note("file", "read error (the map may be incomplete): " + errors_.last());
+    }
+  }
+
+  void readAllFeatures()
+  {
     OGRLayer* layer = nullptr;
     for (;;)
     {
@@ -534,6 +559,11 @@ private:
       const OGRwkbGeometryType type = g != nullptr ? g->getGeometryType() : wkbNone;
       const Role role = roleOf(layer, *f, type);
       if (role == Role::kNone) continue;
+      if (role != Role::kBuilding && p_.exclude_tunnels && isTunnel(*f))
+      {
+        ++r_.excluded_tunnels;
+        continue;
+      }
       const std::string id = featureId(layer, *f);
       if (g == nullptr || g->IsEmpty())
       {
@@ -803,10 +833,11 @@ std::string summary(const MapLoadReport& r)
   s.precision(7);
   s << r.file << " (" << r.driver << "), origin " << r.origin_latitude << ", " << r.origin_longitude << ": "
     << r.features_read << " features read; kept " << r.buildings << " buildings, " << r.road_areas
-    << " road areas, " << r.road_lines << " road lines; repaired " << r.repaired_geometries << "; skipped "
+    << " road areas, " << r.road_lines << " road lines (" << r.excluded_tunnels << " tunnels left out); repaired " << r.repaired_geometries << "; skipped "
     << r.skipped_geometries << " (unclosed " << r.skipped_unclosed << ", missing nodes " << r.skipped_missing_nodes
     << ", degenerate " << r.skipped_degenerate << ", invalid " << r.skipped_invalid << ", out of range "
     << r.skipped_out_of_range << ")";
+  if (r.read_errors > 0) s << "; " << r.read_errors << " read errors: the map may be incomplete";
   return s.str();
 }
 

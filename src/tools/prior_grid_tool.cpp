@@ -1,7 +1,7 @@
 // prior_grid_tool: loads a map as the PriorGridNodelet does, prints what it read and the cells per class,
 // and optionally writes a PNG of the prior in the paper's colours. ROS-free.
 //   prior_grid_tool --map FILE [--origin LAT,LON[,ALT]] [--resolution R] [--png OUT.png] [--source KIND]
-//                   [--metric] [--margin M] [--max-cells N]
+//                   [--metric] [--margin M] [--size S [--centre X,Y]] [--max-cells N]
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -13,6 +13,7 @@
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
+#include "map_aided_fusion/map_io/prior_grid_params.hpp"
 #include "map_aided_fusion/map_io/prior_png.hpp"
 
 using namespace map_aided_fusion;
@@ -26,17 +27,19 @@ constexpr int kExitUsage = 2;
 void usage(std::ostream& os)
 {
   os << "usage: prior_grid_tool --map FILE [--origin LAT,LON[,ALT]] [--resolution R] [--png OUT.png]\n"
-        "                       [--source auto|osm|geojson|shapefile|gpkg] [--metric] [--margin M] [--max-cells N]\n"
+        "                       [--source auto|osm|geojson|shapefile|gpkg] [--metric] [--margin M]\n"
+        "                       [--size S [--centre X,Y]] [--max-cells N]\n"
         "  --map FILE           OpenStreetMap (.osm, .osm.pbf), GeoJSON, Shapefile or GeoPackage map\n"
         "  --origin LAT,LON,ALT origin of the map frame, degrees and metres (default: centre of the data)\n"
         "  --resolution R       cell side in metres (default 0.5)\n"
         "  --png OUT.png        writes the prior: roads white, buildings blue, other grey, north up\n"
         "  --metric             coordinates are already metric in the map frame\n"
         "  --margin M           metres added around the map's extent (default 0)\n"
+        "  --size S             only the S m x S m square around --centre (map frame, default 0,0)\n"
         "  --max-cells N        refuse grids with more cells (default 1.5e9)\n";
 }
 
-bool parseOrigin(const std::string& s, map_io::MapLoadParams& p)
+std::vector<double> parseList(const std::string& s)
 {
   std::vector<double> v;
   std::stringstream ss(s);
@@ -45,9 +48,15 @@ bool parseOrigin(const std::string& s, map_io::MapLoadParams& p)
   {
     char* end = nullptr;
     const double x = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0') return false;
+    if (end == item.c_str() || *end != '\0') return {};
     v.push_back(x);
   }
+  return v;
+}
+
+bool parseOrigin(const std::string& s, map_io::MapLoadParams& p)
+{
+  const std::vector<double> v = parseList(s);
   if (v.size() < 2 || v.size() > 3) return false;
   p.origin_latitude = v[0];
   p.origin_longitude = v[1];
@@ -65,7 +74,8 @@ double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_cloc
 int main(int argc, char** argv)
 {
   map_io::MapLoadParams params;
-  double resolution = kDefaultResolution, margin = 0.0, max_cells = kDefaultMaxCells;
+  double resolution = kDefaultResolution, margin = 0.0, max_cells = kDefaultMaxCells, size = 0.0;
+  std::vector<double> centre{ 0.0, 0.0 };
   std::string png;
   for (int i = 1; i < argc; ++i)
   {
@@ -98,6 +108,13 @@ int main(int argc, char** argv)
       ok = number(margin);
     else if (a == "--max-cells")
       ok = number(max_cells);
+    else if (a == "--size")
+      ok = number(size) && size > 0.0;
+    else if (a == "--centre")
+    {
+      centre = parseList(value());
+      ok = centre.size() == 2;
+    }
     else if (a == "--png")
       png = value();
     else if (a == "--source")
@@ -137,7 +154,17 @@ int main(int argc, char** argv)
     std::cout << map_io::summary(report) << "\n";
     for (const auto& m : report.messages) std::cout << "  skipped " << m << "\n";
 
-    const core::GridGeometry extent = core::PriorGrid::extentOf(map, resolution, margin);
+    core::GridGeometry extent = core::PriorGrid::extentOf(map, resolution, margin);
+    if (size > 0.0)
+    {
+      map_io::PriorGridParams window_params;
+      window_params.publish_size = size;
+      window_params.publish_centre_x = centre[0];
+      window_params.publish_centre_y = centre[1];
+      window_params.max_published_cells = max_cells;
+      bool cropped = false;
+      extent = map_io::publishedWindow(extent, window_params, cropped);
+    }
     if (static_cast<double>(extent.numCells()) > max_cells)
     {
       std::cerr << "prior_grid_tool: the map's extent (" << extent.sizeX() << " m x " << extent.sizeY() << " m) is "
@@ -155,7 +182,8 @@ int main(int argc, char** argv)
               << g.origin_x << ", " << g.origin_y << "), " << grid.bytes() << " bytes ("
               << static_cast<double>(grid.bytes()) / static_cast<double>(g.numCells()) << " byte/cell)\n"
               << "buildings: " << map.buildings.size() << " (" << stats.buildings_rasterised << " rasterised, "
-              << stats.buildings_empty << " cover no cell centre)\n"
+              << stats.buildings_empty << " cover no cell centre, " << stats.buildings_outside
+              << " outside the grid)\n"
               << "roads: " << map.road_areas.size() << " areas, " << map.road_lines.size() << " centre lines\n"
               << "skipped geometries: " << report.skipped_geometries << " while loading, " << stats.skipped_invalid
               << " while rasterising\n"

@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <GeographicLib/LocalCartesian.hpp>
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+#include <ogrsf_frmts.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <string>
@@ -257,6 +261,116 @@ TEST(MapLoader, LayerAndAttributeNamesAreParameters)
   std::filesystem::remove(buildings_path);
 }
 
+/// Writes an IGN BD TOPO-like dataset in Lambert-93 (EPSG:2154): layer BATIMENT (HAUTEUR) with the 10 m square,
+/// layer TRONCON_DE_ROUTE (NATURE, LARGEUR, NB_VOIES) with the 4 m road and a path that is not drivable.
+void writeIgnLike(const std::string& driver_name, const std::string& path)
+{
+  GDALAllRegister();
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(driver_name.c_str());
+  ASSERT_NE(driver, nullptr);
+  GDALDataset* ds = driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+  ASSERT_NE(ds, nullptr);
+  OGRSpatialReference wgs84, lambert93;
+  wgs84.importFromEPSG(4326);
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  lambert93.importFromEPSG(2154);
+  lambert93.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&wgs84, &lambert93));
+  ASSERT_TRUE(ct != nullptr);
+  const GeographicLib::LocalCartesian lc(kFixtureLat, kFixtureLon, 0.0);
+  auto point = [&](double x, double y) {
+    double lat = 0, lon = 0, h = 0;
+    lc.Reverse(x, y, 0.0, lat, lon, h);
+    double e = lon, n = lat;
+    ct->Transform(1, &e, &n);
+    return std::make_pair(e, n);
+  };
+  OGRLayer* bat = ds->CreateLayer("BATIMENT", &lambert93, wkbPolygon, nullptr);
+  OGRFieldDefn hauteur("HAUTEUR", OFTReal);
+  bat->CreateField(&hauteur);
+  {
+    OGRFeature f(bat->GetLayerDefn());
+    f.SetField("HAUTEUR", 7.5);
+    OGRLinearRing ring;
+    for (auto [x, y] : { std::pair{ 2, 2 }, { 12, 2 }, { 12, 12 }, { 2, 12 }, { 2, 2 } })
+    {
+      const auto q = point(x, y);
+      ring.addPoint(q.first, q.second);
+    }
+    OGRPolygon poly;
+    poly.addRing(&ring);
+    f.SetGeometry(&poly);
+    ASSERT_EQ(bat->CreateFeature(&f), OGRERR_NONE);
+  }
+  OGRLayer* routes = ds->CreateLayer("TRONCON_DE_ROUTE", &lambert93, wkbLineString, nullptr);
+  OGRFieldDefn nature("NATURE", OFTString), largeur("LARGEUR", OFTReal), voies("NB_VOIES", OFTInteger);
+  routes->CreateField(&nature);
+  routes->CreateField(&largeur);
+  routes->CreateField(&voies);
+  const auto addRoad = [&](const char* cls, double width, int lanes, double y) {
+    OGRFeature f(routes->GetLayerDefn());
+    f.SetField("NATURE", cls);
+    if (width > 0) f.SetField("LARGEUR", width);
+    f.SetField("NB_VOIES", lanes);
+    OGRLineString ls;
+    for (double x : { -20.0, 20.0 })
+    {
+      const auto q = point(x, y);
+      ls.addPoint(q.first, q.second);
+    }
+    f.SetGeometry(&ls);
+    ASSERT_EQ(routes->CreateFeature(&f), OGRERR_NONE);
+  };
+  addRoad("Route a 1 chaussee", 4.0, 2, -10.0);
+  addRoad("Sentier", 0.0, 1, 15.5);
+  GDALClose(ds);
+}
+
+void checkIgnLike(const std::string& driver_name, const std::string& path, map_io::MapSourceKind kind)
+{
+  std::filesystem::remove_all(path);
+  writeIgnLike(driver_name, path);
+  if (::testing::Test::HasFatalFailure()) return;
+  map_io::MapLoadParams p;
+  p.file = path;
+  p.source = kind;
+  p.origin_latitude = kFixtureLat;
+  p.origin_longitude = kFixtureLon;
+  p.building_layer = "BATIMENT";
+  p.road_layer = "TRONCON_DE_ROUTE";
+  p.building_height_attribute = "HAUTEUR";
+  p.road_class_attribute = "NATURE";
+  p.road_width_attribute = "LARGEUR";
+  p.road_lanes_attribute = "NB_VOIES";
+  p.drivable_classes = { "Route a 1 chaussee", "Route a 2 chaussees" };
+  map_io::MapLoadReport r;
+  const core::VectorMap m = map_io::loadVectorMap(p, &r);
+  ASSERT_EQ(m.buildings.size(), 1u) << map_io::summary(r);
+  EXPECT_DOUBLE_EQ(m.buildings[0].height, 7.5);
+  // Lambert-93 → WGS84 (PROJ) → map frame (GeographicLib): back to the designed corners.
+  EXPECT_NEAR(m.buildings[0].footprint.outer[0].x, 2.0, kMillimetre);
+  EXPECT_NEAR(m.buildings[0].footprint.outer[0].y, 2.0, kMillimetre);
+  ASSERT_EQ(m.road_lines.size(), 1u);  // the path is not drivable
+  EXPECT_DOUBLE_EQ(m.road_lines[0].width, 4.0);
+  core::PriorGrid grid;
+  grid.build(m, testGrid());
+  EXPECT_EQ(count(grid, PriorClass::kBuilding), 100u);
+  EXPECT_EQ(count(grid, PriorClass::kRoad), 160u);
+  std::filesystem::remove_all(path);
+}
+
+TEST(MapLoader, GeoPackageInLambert93WithLayerNames)
+{
+  checkIgnLike("GPKG", (std::filesystem::temp_directory_path() / "maf_test_ign.gpkg").string(),
+               map_io::MapSourceKind::kAuto);
+}
+
+TEST(MapLoader, ShapefileFolderInLambert93WithLayerNames)
+{
+  checkIgnLike("ESRI Shapefile", (std::filesystem::temp_directory_path() / "maf_test_ign_shp").string(),
+               map_io::MapSourceKind::kShapefile);
+}
+
 TEST(MapLoader, WidthFromLanesThenClassDefault)
 {
   const std::string osm = R"(<?xml version="1.0"?><osm version="0.6">
@@ -266,14 +380,22 @@ TEST(MapLoader, WidthFromLanesThenClassDefault)
   <way id="12"><nd ref="1"/><nd ref="2"/><tag k="highway" v="motorway"/><tag k="width" v="24 ft"/></way>
   <way id="13"><nd ref="1"/><nd ref="2"/><tag k="highway" v="cycleway"/></way>
   <way id="14"><nd ref="1"/><nd ref="2"/><tag k="highway" v="service"/><tag k="width" v="wide"/></way>
+  <way id="15"><nd ref="1"/><nd ref="2"/><tag k="highway" v="primary"/><tag k="tunnel" v="yes"/></way>
+  <way id="16"><nd ref="1"/><nd ref="2"/><tag k="highway" v="service"/><tag k="tunnel" v="building_passage"/></way>
+  <node id="3" lat="49.0001" lon="2.0"/><node id="4" lat="49.0001" lon="2.001"/>
+  <way id="17"><nd ref="1"/><nd ref="2"/><nd ref="4"/><nd ref="3"/><nd ref="1"/><tag k="area:highway" v="footway"/></way>
 </osm>)";
   map_io::MapLoadParams p;
   p.file = writeTemp("widths.osm", osm);
   p.origin_latitude = kFixtureLat;
   p.origin_longitude = kFixtureLon;
   p.lane_width = 3.25;
-  const core::VectorMap m = map_io::loadVectorMap(p);
-  ASSERT_EQ(m.road_lines.size(), 4u);
+  map_io::MapLoadReport r;
+  const core::VectorMap m = map_io::loadVectorMap(p, &r);
+  ASSERT_EQ(m.road_lines.size(), 5u);   // 10, 11, 12, 14 and the building passage 16; not the cycleway
+  EXPECT_EQ(r.excluded_tunnels, 1u);    // 15
+  EXPECT_TRUE(m.road_areas.empty());    // an area:highway=footway pavement is not road
+  EXPECT_EQ(r.skipped_geometries, 0u);
   std::map<std::string, double> widths;
   for (const auto& l : m.road_lines) widths[l.id] = l.width;
   EXPECT_DOUBLE_EQ(widths["way/10"], 3 * 3.25);
@@ -301,6 +423,16 @@ TEST(MapLoader, BadInputGivesClearErrors)
   <way id="10"><nd ref="1"/><nd ref="2"/><tag k="highway" v="footway"/></way></osm>)");
   e = errorOf([&] { map_io::loadVectorMap(p); });
   EXPECT_NE(e.find("no usable"), std::string::npos) << e;
+  std::filesystem::remove(p.file);
+
+  {
+    std::ifstream in(kFixtures + "blocks.osm");
+    const std::string whole((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    p.file = writeTemp("truncated.osm", whole.substr(0, whole.size() / 2));  // cut inside the nodes
+  }
+  e = errorOf([&] { map_io::loadVectorMap(p); });
+  EXPECT_NE(e.find("truncated.osm"), std::string::npos) << e;
+  EXPECT_NE(e.find("read error"), std::string::npos) << e;
   std::filesystem::remove(p.file);
 
   p = fixtureParams("blocks.osm");
@@ -388,6 +520,7 @@ void checkRealExtract(const std::string& name, std::size_t min_buildings, double
             << stats.buildings_rasterised << " buildings rasterised, " << stats.buildings_empty
             << " smaller than a cell" << std::endl;
   // None dropped silently: every kept building is either rasterised or counted as covering no cell centre.
+  EXPECT_EQ(stats.buildings_outside, 0u);
   EXPECT_EQ(stats.buildings_rasterised + stats.buildings_empty + stats.skipped_invalid, m.buildings.size());
   EXPECT_GE(static_cast<double>(stats.buildings_rasterised), 0.98 * static_cast<double>(m.buildings.size()));
   const auto n = grid.classCounts();

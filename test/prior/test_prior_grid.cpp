@@ -128,6 +128,18 @@ TEST(ScanlineRasterizer, ClipsToTheGridAndIgnoresNonFiniteRings)
   EXPECT_TRUE(spans.empty());
   r.fill(Ring{ { 0, 0 }, { 1, 1 } }, spans);
   EXPECT_TRUE(spans.empty());
+  // Absurd but finite coordinates: clamped, no overflow.
+  r.fill(Ring{ { -1e300, -1e300 }, { 1e300, -1e300 }, { 1e300, 1e300 }, { -1e300, 1e300 } }, spans);
+  EXPECT_EQ(cellsOf(spans), 1600u);
+}
+
+TEST(PriorGrid, HugeExtentIsAnError)
+{
+  VectorMap m;
+  Building b;
+  b.footprint.outer = rect(0, 0, 1e12, 1);
+  m.buildings.push_back(b);
+  EXPECT_THROW(PriorGrid::extentOf(m, 0.5), ParameterError);
 }
 
 // Crossing-number point-in-polygon with the same half-open convention.
@@ -230,7 +242,18 @@ TEST(PriorGrid, InvalidGeometryIsSkippedAndCounted)
   PriorBuildStats stats;
   grid.build(m, testGrid(), &stats);
   EXPECT_EQ(stats.skipped_invalid, 2u);
+  EXPECT_EQ(stats.buildings_outside, 0u);
   EXPECT_EQ(grid.classCounts()[static_cast<int>(PriorClass::kBuilding)], 372u);
+  // A window that misses the cloister: counted outside, not empty; a sliver smaller than a cell: empty.
+  Building sliver;
+  sliver.footprint.outer = rect(0.6, 0.6, 1.4, 1.4);
+  m.buildings.push_back(sliver);
+  GridGeometry right = testGrid();
+  right.origin_x = 0.0;  // x ∈ [0, 40]: the cloister (x ≤ −2) and the garage (x ≤ −5) are outside
+  grid.build(m, right, &stats);
+  EXPECT_EQ(stats.buildings_outside, 2u);
+  EXPECT_EQ(stats.buildings_empty, 1u);
+  EXPECT_EQ(stats.buildings_rasterised, 1u);
 }
 
 TEST(PriorGrid, ExtentIsSnappedToTheResolution)

@@ -28,7 +28,8 @@ namespace core {
 struct PriorBuildStats
 {
   std::size_t buildings_rasterised = 0;  ///< buildings covering at least one cell centre
-  std::size_t buildings_empty = 0;       ///< buildings covering no cell centre (smaller than a cell, or outside)
+  std::size_t buildings_empty = 0;       ///< buildings over the grid covering no cell centre (smaller than a cell)
+  std::size_t buildings_outside = 0;     ///< buildings whose bounding box misses the grid (e.g. a cropped window)
   std::size_t road_areas_rasterised = 0; ///< road areas covering at least one cell centre
   std::size_t road_lines_rasterised = 0; ///< road centre lines covering at least one cell centre
   std::size_t skipped_invalid = 0;       ///< polygons/lines with non-finite vertices or a non-positive width

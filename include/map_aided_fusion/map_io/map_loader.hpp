@@ -9,8 +9,11 @@
  * What is a building, a road area, a road centre line:
  *  - building: a polygon (closed OSM way or multipolygon relation) whose `building_attribute` is set and not
  *    "no"; or any polygon of `building_layer` when that parameter is set. Holes (courtyards) are kept.
- *  - road area: a polygon whose `road_area_attribute` (`area:highway`) is set, or a polygon with a drivable
- *    `road_class_attribute` and `area=yes`; or any polygon of `road_area_layer`.
+ *  - road area: a polygon whose `road_area_attribute` (`area:highway`) is a drivable class (an
+ *    `area:highway=footway` pavement is not road), or a polygon with a drivable `road_class_attribute` and
+ *    `area=yes`; or any polygon of `road_area_layer`.
+ *  - tunnels (`road_tunnel_attribute` set and not "no" or "building_passage") are not road surface when
+ *    `exclude_tunnels` is set: they are counted in MapLoadReport::excluded_tunnels, not skipped.
  *  - road centre line: a line whose `road_class_attribute` (`highway`) is one of `drivable_classes`
  *    (or any line of `road_layer`, filtered by class when the class attribute exists and the list is not
  *    {"*"}). Its width: `road_width_attribute` when > 0, else `road_lanes_attribute` × lane_width, else
@@ -86,7 +89,9 @@ struct MapLoadParams
   std::string road_class_attribute = "highway";               ///< road class (IGN: "NATURE")
   std::string road_width_attribute = "width";                 ///< metres (IGN: "LARGEUR")
   std::string road_lanes_attribute = "lanes";                 ///< lanes (IGN: "NB_VOIES")
-  std::string road_area_attribute = "area:highway";           ///< set: the polygon is a road surface
+  std::string road_area_attribute = "area:highway";           ///< drivable class: the polygon is a road surface
+  std::string road_tunnel_attribute = "tunnel";               ///< set and not "no"/"building_passage": a tunnel
+  bool exclude_tunnels = true;  ///< tunnels are underground: not road surface of the grid
 
   /// Road classes that are road surface; {"*"} accepts every class.
   std::vector<std::string> drivable_classes = defaultDrivableClasses();
@@ -121,12 +126,14 @@ struct MapLoadReport
   std::size_t road_areas = 0;              ///< road area polygons kept
   std::size_t road_lines = 0;              ///< road centre lines kept
   std::size_t repaired_geometries = 0;     ///< invalid polygons repaired
+  std::size_t excluded_tunnels = 0;        ///< drivable roads left out because they are tunnels
   std::size_t skipped_geometries = 0;      ///< total skipped (the sum of the counts below)
   std::size_t skipped_unclosed = 0;        ///< building/road-area ways that are not closed rings
   std::size_t skipped_missing_nodes = 0;   ///< ways with nodes missing from the extract
   std::size_t skipped_degenerate = 0;      ///< fewer than 3 distinct vertices (polygons) or 2 (lines), NaN
   std::size_t skipped_invalid = 0;         ///< invalid polygons not repaired
   std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance from the origin
+  std::size_t read_errors = 0;             ///< GDAL errors while reading features (truncated file…)
   std::vector<std::string> messages;       ///< the first few skip reasons, with feature ids
 };
 

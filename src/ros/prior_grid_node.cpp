@@ -1,0 +1,253 @@
+#include "map_aided_fusion/ros/prior_grid_node.hpp"
+
+#include <algorithm>
+#include <map>
+#include <vector>
+
+#include <geometry_msgs/Point.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "map_aided_fusion/EvidentialGrid.h"
+#include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/ros/conversions.hpp"
+
+namespace map_aided_fusion {
+
+namespace {
+
+constexpr std::size_t kMaxLoggedSkips = 10;
+constexpr double kOutlineWidth = 0.2;  // metres
+constexpr int kQueueSize = 1;
+
+struct Rgba
+{
+  float r, g, b, a;
+};
+constexpr Rgba kBuildingColour{ 0.0f, 0.0f, 1.0f, 1.0f };
+constexpr Rgba kRoadAreaColour{ 1.0f, 1.0f, 1.0f, 1.0f };
+constexpr Rgba kRoadLineColour{ 0.8f, 0.8f, 0.8f, 1.0f };
+
+template <class T>
+void param(const ros::NodeHandle& pnh, const std::string& name, T& value)
+{
+  pnh.param(name, value, value);
+}
+
+bool inside(const core::GridGeometry& g, const core::Point2& p)
+{
+  return p.x >= g.origin_x && p.y >= g.origin_y && p.x <= g.origin_x + g.sizeX() && p.y <= g.origin_y + g.sizeY();
+}
+
+bool touches(const core::GridGeometry& g, const std::vector<core::Point2>& pts)
+{
+  return std::any_of(pts.begin(), pts.end(), [&](const core::Point2& p) { return inside(g, p); });
+}
+
+geometry_msgs::Point point(const core::Point2& p)
+{
+  geometry_msgs::Point q;
+  q.x = p.x;
+  q.y = p.y;
+  q.z = 0.0;
+  return q;
+}
+
+void addRing(const std::vector<core::Point2>& ring, bool closed, visualization_msgs::Marker& m)
+{
+  const std::size_t n = ring.size();
+  if (n < 2) return;
+  const std::size_t edges = closed ? n : n - 1;
+  for (std::size_t i = 0; i < edges; ++i)
+  {
+    m.points.push_back(point(ring[i]));
+    m.points.push_back(point(ring[(i + 1) % n]));
+  }
+}
+
+visualization_msgs::Marker lineList(const std_msgs::Header& header, const std::string& ns, int id, Rgba c)
+{
+  visualization_msgs::Marker m;
+  m.header = header;
+  m.ns = ns;
+  m.id = id;
+  m.type = visualization_msgs::Marker::LINE_LIST;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = kOutlineWidth;
+  m.color.r = c.r;
+  m.color.g = c.g;
+  m.color.b = c.b;
+  m.color.a = c.a;
+  return m;
+}
+
+}  // namespace
+
+map_io::PriorGridParams readPriorGridParams(const ros::NodeHandle& pnh)
+{
+  map_io::PriorGridParams p;
+  map_io::MapLoadParams& m = p.map;
+  param(pnh, "map_file", m.file);
+  std::string source = map_io::toString(m.source);
+  param(pnh, "source", source);
+  m.source = map_io::parseMapSourceKind(source);
+  param(pnh, "origin_latitude", m.origin_latitude);
+  param(pnh, "origin_longitude", m.origin_longitude);
+  param(pnh, "origin_altitude", m.origin_altitude);
+  param(pnh, "metric", m.metric);
+  param(pnh, "max_origin_distance", m.max_origin_distance);
+  param(pnh, "building_layer", m.building_layer);
+  param(pnh, "road_layer", m.road_layer);
+  param(pnh, "road_area_layer", m.road_area_layer);
+  param(pnh, "building_attribute", m.building_attribute);
+  param(pnh, "building_height_attribute", m.building_height_attribute);
+  param(pnh, "building_levels_attribute", m.building_levels_attribute);
+  param(pnh, "road_class_attribute", m.road_class_attribute);
+  param(pnh, "road_width_attribute", m.road_width_attribute);
+  param(pnh, "road_lanes_attribute", m.road_lanes_attribute);
+  param(pnh, "road_area_attribute", m.road_area_attribute);
+  param(pnh, "road_tunnel_attribute", m.road_tunnel_attribute);
+  param(pnh, "exclude_tunnels", m.exclude_tunnels);
+  param(pnh, "drivable_classes", m.drivable_classes);
+  param(pnh, "lane_width", m.lane_width);
+  param(pnh, "level_height", m.level_height);
+  param(pnh, "default_road_width", m.default_road_width);
+  std::map<std::string, double> widths;
+  if (pnh.getParam("road_class_widths", widths))
+    for (const auto& kv : widths) m.road_class_widths[kv.first] = kv.second;
+  param(pnh, "repair_invalid", m.repair_invalid);
+  param(pnh, "frame_id", p.frame_id);
+  param(pnh, "resolution", p.resolution);
+  param(pnh, "beta_building", p.beta.beta_building);
+  param(pnh, "beta_road", p.beta.beta_road);
+  param(pnh, "beta_other", p.beta.beta_other);
+  param(pnh, "margin", p.margin);
+  param(pnh, "publish_size", p.publish_size);
+  param(pnh, "publish_centre_x", p.publish_centre_x);
+  param(pnh, "publish_centre_y", p.publish_centre_y);
+  param(pnh, "max_published_cells", p.max_published_cells);
+  param(pnh, "publish_outlines", p.publish_outlines);
+  return p;
+}
+
+PriorGridNode::PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh)
+{
+  const bool latched = true;
+  prior_pub_ = nh_.advertise<EvidentialGrid>("prior_grid", kQueueSize, latched);
+  occupancy_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("prior_grid/occupancy", kQueueSize, latched);
+  outlines_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("prior_grid/outlines", kQueueSize, latched);
+  reload_srv_ = pnh_.advertiseService("reload", &PriorGridNode::reload, this);
+  load();
+}
+
+bool PriorGridNode::reload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res)
+{
+  res.success = load();
+  res.message = status_;
+  return true;
+}
+
+bool PriorGridNode::load()
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  try
+  {
+    map_io::PriorGridParams params = readPriorGridParams(pnh_);
+    params.validate();
+    map_io::MapLoadReport report;
+    const core::VectorMap map = map_io::loadVectorMap(params.map, &report);
+    ROS_INFO_STREAM("prior_grid: " << map_io::summary(report));
+    for (std::size_t i = 0; i < std::min(kMaxLoggedSkips, report.messages.size()); ++i)
+      ROS_WARN_STREAM("prior_grid: skipped " << report.messages[i]);
+    publish(params, map);
+    loaded_ = true;
+  }
+  catch (const core::ParameterError& e)
+  {
+    status_ = std::string("invalid parameter ") + e.what();
+    loaded_ = false;
+  }
+  catch (const std::exception& e)
+  {
+    status_ = e.what();
+    loaded_ = false;
+  }
+  if (!loaded_) ROS_ERROR_STREAM("prior_grid: " << status_ << "; nothing published");
+  return loaded_;
+}
+
+void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::VectorMap& map)
+{
+  const core::GridGeometry extent = core::PriorGrid::extentOf(map, params.resolution, params.margin);
+  bool cropped = false;
+  const core::GridGeometry window = map_io::publishedWindow(extent, params, cropped);
+  if (cropped)
+    ROS_WARN_STREAM("prior_grid: the map's extent (" << extent.sizeX() << " m x " << extent.sizeY() << " m) exceeds "
+                    << "max_published_cells = " << params.max_published_cells << "; publishing " << window.sizeX()
+                    << " m x " << window.sizeY() << " m around (" << params.publish_centre_x << ", "
+                    << params.publish_centre_y << ")");
+  core::PriorBuildStats stats;
+  grid_.build(map, window, &stats);
+  const core::PriorClassCounts n = grid_.classCounts();
+  status_ = "published " + std::to_string(window.width) + " x " + std::to_string(window.height) + " cells: " +
+            std::to_string(n[static_cast<int>(core::PriorClass::kBuilding)]) + " building, " +
+            std::to_string(n[static_cast<int>(core::PriorClass::kRoad)]) + " road, " +
+            std::to_string(n[static_cast<int>(core::PriorClass::kOther)]) + " other; " +
+            std::to_string(stats.buildings_rasterised) + " buildings rasterised, " +
+            std::to_string(map.skipped_geometries + stats.skipped_invalid) + " geometries skipped";
+  ROS_INFO_STREAM("prior_grid: " << status_);
+
+  std_msgs::Header header;
+  header.stamp = ros::Time::now();
+  header.frame_id = params.frame_id;
+
+  core::PriorWindow prior;
+  grid_.fillWindow(window, params.beta, prior);
+  EvidentialGrid msg;
+  GridConversions::toMessage(prior, header, msg);
+  prior_pub_.publish(msg);
+
+  nav_msgs::OccupancyGrid occ;
+  occ.header = header;
+  GridConversions::toMapMetaData(window, occ.info);
+  occ.info.map_load_time = header.stamp;
+  occ.data.resize(window.numCells());
+  const auto& labels = grid_.labels();
+  for (std::size_t i = 0; i < labels.size(); ++i)
+  {
+    switch (labels[i])
+    {
+      case core::PriorClass::kBuilding: occ.data[i] = kPriorOccupancyBuilding; break;
+      case core::PriorClass::kRoad: occ.data[i] = kPriorOccupancyRoad; break;
+      case core::PriorClass::kOther: occ.data[i] = kPriorOccupancyOther; break;
+      case core::PriorClass::kUnknown: occ.data[i] = kPriorOccupancyUnknown; break;
+    }
+  }
+  occupancy_pub_.publish(occ);
+
+  if (!params.publish_outlines) return;
+  visualization_msgs::MarkerArray outlines;
+  visualization_msgs::Marker buildings = lineList(header, "buildings", 0, kBuildingColour);
+  visualization_msgs::Marker areas = lineList(header, "road_areas", 1, kRoadAreaColour);
+  visualization_msgs::Marker lines = lineList(header, "road_lines", 2, kRoadLineColour);
+  for (const auto& b : map.buildings)
+  {
+    if (!touches(window, b.footprint.outer)) continue;
+    addRing(b.footprint.outer, true, buildings);
+    for (const auto& h : b.footprint.holes) addRing(h, true, buildings);
+  }
+  for (const auto& a : map.road_areas)
+  {
+    if (!touches(window, a.outer)) continue;
+    addRing(a.outer, true, areas);
+    for (const auto& h : a.holes) addRing(h, true, areas);
+  }
+  for (const auto& l : map.road_lines)
+    if (touches(window, l.points)) addRing(l.points, false, lines);
+  for (auto* m : { &buildings, &areas, &lines })
+    if (!m->points.empty()) outlines.markers.push_back(*m);
+  outlines_pub_.publish(outlines);
+}
+
+}  // namespace map_aided_fusion

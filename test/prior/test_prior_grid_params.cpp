@@ -1,0 +1,110 @@
+// PriorGridParams validation and the published window (cap on the message size).
+#include <gtest/gtest.h>
+
+#include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/map_io/prior_grid_params.hpp"
+
+namespace {
+
+using namespace map_aided_fusion;
+
+map_io::PriorGridParams valid()
+{
+  map_io::PriorGridParams p;
+  p.map.file = "town.osm";
+  return p;
+}
+
+core::GridGeometry extent()
+{
+  core::GridGeometry g;  // 100 m × 60 m at 0.5 m, from (−30, −20)
+  g.resolution = 0.5;
+  g.width = 200;
+  g.height = 120;
+  g.origin_x = -30.0;
+  g.origin_y = -20.0;
+  return g;
+}
+
+std::string offending(const map_io::PriorGridParams& p)
+{
+  try
+  {
+    p.validate();
+  }
+  catch (const core::ParameterError& e)
+  {
+    return e.parameter();
+  }
+  return "";
+}
+
+TEST(PriorGridParams, ValidationNamesTheParameter)
+{
+  EXPECT_EQ(offending(valid()), "");
+  auto p = valid();
+  p.resolution = 0.0;
+  EXPECT_EQ(offending(p), "resolution");
+  p = valid();
+  p.beta.beta_road = 1.5;
+  EXPECT_EQ(offending(p), "beta_road");
+  p = valid();
+  p.publish_size = -1.0;
+  EXPECT_EQ(offending(p), "publish_size");
+  p = valid();
+  p.max_published_cells = 0.0;
+  EXPECT_EQ(offending(p), "max_published_cells");
+  p = valid();
+  p.map.file.clear();
+  EXPECT_EQ(offending(p), "map_file");
+  p = valid();
+  p.frame_id.clear();
+  EXPECT_EQ(offending(p), "frame_id");
+}
+
+TEST(PublishedWindow, WholeExtentByDefault)
+{
+  bool cropped = true;
+  const core::GridGeometry w = map_io::publishedWindow(extent(), valid(), cropped);
+  EXPECT_FALSE(cropped);
+  EXPECT_EQ(w, extent());
+}
+
+TEST(PublishedWindow, BoxAroundTheCentreClippedToTheExtent)
+{
+  auto p = valid();
+  p.publish_size = 20.0;
+  p.publish_centre_x = 65.0;  // box x ∈ [55, 75], extent ends at 70
+  p.publish_centre_y = 0.0;   // y ∈ [−10, 10]
+  bool cropped = true;
+  const core::GridGeometry w = map_io::publishedWindow(extent(), p, cropped);
+  EXPECT_FALSE(cropped);
+  EXPECT_DOUBLE_EQ(w.origin_x, 55.0);
+  EXPECT_EQ(w.width, 30);  // [55, 70]
+  EXPECT_DOUBLE_EQ(w.origin_y, -10.0);
+  EXPECT_EQ(w.height, 40);
+  p.publish_centre_x = 500.0;
+  EXPECT_THROW(map_io::publishedWindow(extent(), p, cropped), core::ParameterError);
+}
+
+TEST(PublishedWindow, CappedToASquareAroundTheCentre)
+{
+  auto p = valid();
+  p.max_published_cells = 1600.0;  // 40 × 40 cells = 20 m × 20 m
+  bool cropped = false;
+  const core::GridGeometry w = map_io::publishedWindow(extent(), p, cropped);
+  EXPECT_TRUE(cropped);
+  EXPECT_EQ(w.width, 40);
+  EXPECT_EQ(w.height, 40);
+  EXPECT_DOUBLE_EQ(w.origin_x, -10.0);  // centred on the origin (0, 0)
+  EXPECT_DOUBLE_EQ(w.origin_y, -10.0);
+  // Near a corner the square slides inside the extent.
+  p.publish_centre_x = 69.0;
+  p.publish_centre_y = -19.0;
+  const core::GridGeometry c = map_io::publishedWindow(extent(), p, cropped);
+  EXPECT_DOUBLE_EQ(c.origin_x, 50.0);
+  EXPECT_DOUBLE_EQ(c.origin_y, -20.0);
+  EXPECT_LE(c.numCells(), 1600u);
+}
+
+}  // namespace
