@@ -212,6 +212,20 @@ MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T (&sp)[kNumS
   return k;
 }
 
+/// CombinationRule as int, for the kernels.
+constexpr int kRuleModifiedYager = 0;
+constexpr int kRuleYager = 1;
+constexpr int kRuleDempster = 2;
+
+/// Classical discounting: m ← (1 − α) m, m(Ω) += α.
+template <typename T>
+MAF_INLINE void classicalDiscount(T (&m)[kSubsets], float alpha)
+{
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a) m[a] *= 1.0f - alpha;
+  m[FrameMG::kOmega] += alpha;
+}
+
 /// Conflicts met by ⊛ for one cell.
 template <typename T>
 struct CellConflicts
@@ -279,7 +293,7 @@ MAF_INLINE void conjunctiveWithScanPrior(const T (&m)[kSubsets], const T (&sp)[k
  * m ← m ⊛ sp (sp in the sets of kScanPriorSets), the modified Yager rule; returns the conflicts.
  */
 template <typename T>
-MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumScanPrior])
+MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumScanPrior], int rule = 0)
 {
   T c[kSubsets];
   conjunctiveWithScanPrior(m, sp, c);
@@ -292,8 +306,25 @@ MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumSc
   r.free_occupied = m[FrameMG::kF] * scan_occupied;
   r.occupied_free = map_occupied * sp[kSpF];
   r.other = c[0] - r.free_occupied - r.occupied_free;
-  c[FrameMG::kV] += r.free_occupied;
-  c[FrameMG::kOmega] += c[0] - r.free_occupied;
+  if (rule == kRuleModifiedYager)
+  {
+    c[FrameMG::kV] += r.free_occupied;
+    c[FrameMG::kOmega] += c[0] - r.free_occupied;
+  }
+  else if (rule == kRuleYager)
+  {
+    c[FrameMG::kOmega] += c[0];
+  }
+  else
+  {
+    const T one = splat<T>(1.0f), zero{};
+    const T norm = one - c[0];
+    const auto total = norm < splat<T>(1e-12f);
+    const T inv = select(total, zero, one / norm);
+    MAF_UNROLL
+    for (int a = 1; a < kSubsets; ++a) c[a] *= inv;
+    c[FrameMG::kOmega] += select(total, one, zero);
+  }
   c[0] = T{};
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a) m[a] = c[a];

@@ -17,8 +17,17 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   DempsterReport report;
   const MassMG scan_prior = dempster(refine(scan), prior, &report);
   r.scan_prior_total_conflict = report.total_conflict;
-  const MassMG discounted = contextualDiscount(map_prev, params.discount);
-  const MassMG fused = modifiedYager(discounted, scan_prior, &r.conflicts);
+  const MassMG discounted = params.contextual_discounting ? contextualDiscount(map_prev, params.discount)
+                                                          : discount(map_prev, params.alpha_single);
+  MassMG fused = modifiedYager(discounted, scan_prior, &r.conflicts);
+  if (params.rule == CombinationRule::kYager) fused = yager(discounted, scan_prior);
+  if (params.rule == CombinationRule::kDempster) fused = dempster(discounted, scan_prior);
+  if (!params.use_counter)
+  {
+    r.zeta = zeta_prev;
+    r.mass = fused;
+    return r;
+  }
   r.zeta = updateCounter(zeta_prev, fused.massInside(FrameMG::kO), r.conflicts, params.counter);
   r.mass = specialise(fused, r.zeta, params.counter.mode);
   return r;
@@ -41,6 +50,10 @@ struct StepInputs
   const float* pt;
   float delta_inc, delta_dec, gamma_occupied, gamma_conflict, threshold;
   bool literal;
+  int rule;
+  bool contextual;
+  float alpha_single;
+  bool use_counter;
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
 };
 
@@ -63,12 +76,19 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     kernels::scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i),
                            kHasPrior ? load<T>(in.pb + i) : zero, kHasPrior ? load<T>(in.pr + i) : zero,
                            kHasPrior ? load<T>(in.pt + i) : zero, sp, in.threshold);
-    kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
-    const auto c = kernels::modifiedYager(m, sp);
-    const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m), c.free_occupied + c.occupied_free,
-                                       in.delta_inc, in.delta_dec, in.gamma_occupied, in.gamma_conflict);
-    kernels::store(zeta + i, z);
-    kernels::specialise(m, z, in.literal);
+    if (in.contextual)
+      kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
+    else
+      kernels::classicalDiscount(m, in.alpha_single);
+    const auto c = kernels::modifiedYager(m, sp, in.rule);
+    if (in.use_counter)
+    {
+      const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m),
+                                         c.free_occupied + c.occupied_free, in.delta_inc, in.delta_dec,
+                                         in.gamma_occupied, in.gamma_conflict);
+      kernels::store(zeta + i, z);
+      kernels::specialise(m, z, in.literal);
+    }
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
     if (in.betp[0])
@@ -116,6 +136,12 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   in.gamma_conflict = static_cast<float>(params.counter.gamma_conflict);
   in.threshold = static_cast<float>(kTotalConflictThreshold);
   in.literal = params.counter.mode == SpecialisationMode::kLiteral;
+  in.rule = params.rule == CombinationRule::kModifiedYager ? kernels::kRuleModifiedYager
+            : params.rule == CombinationRule::kYager       ? kernels::kRuleYager
+                                                           : kernels::kRuleDempster;
+  in.contextual = params.contextual_discounting;
+  in.alpha_single = static_cast<float>(params.alpha_single);
+  in.use_counter = params.use_counter;
   for (int e = 0; e < FrameMG::kSize; ++e)
   {
     if (betp) betp->p[e].resize(in.cells);

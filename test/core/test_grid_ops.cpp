@@ -247,6 +247,40 @@ TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
     }
 }
 
+TEST(FusionStep, AblationVariantsMatchTheScalarReference)
+{
+  struct Variant
+  {
+    CombinationRule rule;
+    bool contextual;
+    bool counter;
+  };
+  for (const Variant v : { Variant{ CombinationRule::kYager, true, true }, Variant{ CombinationRule::kDempster, true, true },
+                           Variant{ CombinationRule::kModifiedYager, false, true },
+                           Variant{ CombinationRule::kModifiedYager, true, false } })
+  {
+    std::mt19937 rng(9);
+    const auto g = testGeometry();
+    auto map = randomMapGrid(rng, g);
+    const auto before = map;
+    const auto scan = randomScanGrid(rng, g);
+    const auto prior = randomPrior(rng, g, PriorConfidence{ 1.0, 0.85, 0.7 });
+    FusionParams params;
+    params.rule = v.rule;
+    params.contextual_discounting = v.contextual;
+    params.alpha_single = 0.15;
+    params.use_counter = v.counter;
+    fusionStep(map, scan, &prior, params);
+    for (std::size_t i = 0; i < map.numCells(); ++i)
+    {
+      const auto ref = fuseCell(before.cell(i), before.counter()[i], scan.cell(i), prior.cell(i), params);
+      ASSERT_TRUE(massNear(map.cell(i), ref.mass, kFloatTolerance)) << "cell " << i;
+      ASSERT_NEAR(map.counter()[i], ref.zeta, 1e-6);
+      ASSERT_TRUE(isValidMass(map.cell(i), kFloatTolerance));
+    }
+  }
+}
+
 TEST(FusionStep, RejectsMismatchedGeometries)
 {
   MapMassGrid map(testGeometry());

@@ -14,22 +14,39 @@
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/grid_ops.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
+#include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior.hpp"
 #include "map_aided_fusion/core/rules.hpp"
 
 namespace map_aided_fusion {
 namespace core {
 
-/// Everything one fusion step needs.
+/// The rule that fuses the discounted MapGrid with the ScanGrid (the paper's is kModifiedYager).
+enum class CombinationRule
+{
+  kModifiedYager,  ///< ⊛: ∅_FO → {V}, the rest of the conflict → Ω (the paper)
+  kYager,          ///< all the conflict → Ω
+  kDempster,       ///< normalised; total conflict gives the vacuous mass function
+};
+
+/// Everything one fusion step needs. The defaults are the paper's method; the other options exist for
+/// ablation studies (evaluate's variants).
 struct FusionParams
 {
   ContextualRates discount;  ///< α, per scan
   CounterParams counter;     ///< δ_inc, δ_dec, γ_O, γ_∅ and the specialisation mode
+  CombinationRule rule = CombinationRule::kModifiedYager;
+  /// false: classical discounting with the single rate alpha_single instead of contextual discounting
+  bool contextual_discounting = true;
+  double alpha_single = 0.1;  ///< rate of the classical discounting, in [0, 1]
+  /// false: no counter and no specialisation (ζ stays 0)
+  bool use_counter = true;
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const
   {
     discount.validate();
     counter.validate();
+    requireUnit("alpha_single", alpha_single);
   }
 };
 
