@@ -1,0 +1,304 @@
+#include "map_aided_fusion/eval/metrics.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace map_aided_fusion {
+namespace eval {
+
+using core::CellClass;
+
+namespace {
+
+constexpr int kMoving = static_cast<int>(CellClass::kMoving);
+constexpr int kStopped = static_cast<int>(CellClass::kStopped);
+constexpr int kFree = static_cast<int>(CellClass::kFree);
+
+double ratio(double a, double b) { return b > 0.0 ? a / b : 0.0; }
+
+std::string number(double v)
+{
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string escape(const std::string& s)
+{
+  std::string out;
+  for (char c : s)
+  {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::int8_t ClassGrid::at(core::Point2 p) const
+{
+  core::CellIndex c;
+  if (!geometry.worldToCell(p, c)) return static_cast<std::int8_t>(CellClass::kUnknown);
+  return cells[geometry.index(c)];
+}
+
+void ConfusionMatrix::add(int truth, int decision, std::uint64_t count)
+{
+  if (truth < 0 || truth >= kNumCellClasses) return;
+  const int col = decision >= 0 && decision < kNumCellClasses ? decision : kUnknownColumn;
+  counts_[truth][col] += count;
+}
+
+void ConfusionMatrix::add(const ConfusionMatrix& other)
+{
+  for (int t = 0; t < kNumCellClasses; ++t)
+    for (int d = 0; d <= kNumCellClasses; ++d) counts_[t][d] += other.counts_[t][d];
+}
+
+double ConfusionMatrix::precision(int c) const
+{
+  double decided = 0;
+  for (int t = 0; t < kNumCellClasses; ++t) decided += counts_[t][c];
+  return ratio(counts_[c][c], decided);
+}
+
+double ConfusionMatrix::recall(int c) const { return ratio(counts_[c][c], support(c)); }
+
+double ConfusionMatrix::iou(int c) const
+{
+  double decided = 0;
+  for (int t = 0; t < kNumCellClasses; ++t) decided += counts_[t][c];
+  const double tp = counts_[c][c];
+  return ratio(tp, decided + support(c) - tp);
+}
+
+std::uint64_t ConfusionMatrix::support(int c) const
+{
+  std::uint64_t s = 0;
+  for (int d = 0; d <= kNumCellClasses; ++d) s += counts_[c][d];
+  return s;
+}
+
+double ConfusionMatrix::coverage() const
+{
+  double all = 0, unknown = 0;
+  for (int t = 0; t < kNumCellClasses; ++t)
+  {
+    all += support(t);
+    unknown += counts_[t][kUnknownColumn];
+  }
+  return ratio(all - unknown, all);
+}
+
+double ConfusionMatrix::accuracy() const
+{
+  double decided = 0, right = 0;
+  for (int t = 0; t < kNumCellClasses; ++t)
+  {
+    right += counts_[t][t];
+    for (int d = 0; d < kNumCellClasses; ++d) decided += counts_[t][d];
+  }
+  return ratio(right, decided);
+}
+
+double ConfusionMatrix::meanIou() const
+{
+  double s = 0;
+  int n = 0;
+  for (int c = 0; c < kNumCellClasses; ++c)
+    if (support(c) > 0)
+    {
+      s += iou(c);
+      ++n;
+    }
+  return ratio(s, n);
+}
+
+std::uint64_t accumulate(const ClassGrid& truth, const ClassGrid& decision, ConfusionMatrix& m)
+{
+  std::uint64_t compared = 0;
+  const auto& g = truth.geometry;
+  for (std::size_t i = 0; i < truth.cells.size(); ++i)
+  {
+    const int t = truth.cells[i];
+    if (t < 0 || t >= kNumCellClasses) continue;
+    m.add(t, decision.at(g.cellCentre(g.cellOf(i))));
+    ++compared;
+  }
+  return compared;
+}
+
+bool TruthObject::contains(core::Point2 p) const
+{
+  const double dx = p.x - centre.x, dy = p.y - centre.y;
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const double u = c * dx + s * dy, v = -s * dx + c * dy;
+  return std::abs(u) <= 0.5 * length && std::abs(v) <= 0.5 * width;
+}
+
+ObjectScorer::ObjectScorer(int min_visible_cells, double detection_window)
+  : min_visible_(min_visible_cells), window_(detection_window)
+{
+}
+
+void ObjectScorer::add(double stamp, const ClassGrid& truth, const std::vector<TruthObject>& objects,
+                       const ClassGrid& decision)
+{
+  ++scans_;
+  const auto& g = truth.geometry;
+  for (std::size_t i = 0; i < truth.cells.size(); ++i)
+  {
+    if (truth.cells[i] != kFree) continue;
+    ++free_cells_;
+    trail_cells_ += decision.at(g.cellCentre(g.cellOf(i))) == kMoving;
+  }
+  for (const auto& o : objects)
+  {
+    const int cls = static_cast<int>(o.cell_class);
+    if (cls != kMoving && cls != kStopped) continue;
+    // Footprint cells of the object observed with its class.
+    const double r = 0.5 * std::hypot(o.length, o.width);
+    const core::CellIndex lo = g.cellAt(core::Point2{ o.centre.x - r, o.centre.y - r });
+    const core::CellIndex hi = g.cellAt(core::Point2{ o.centre.x + r, o.centre.y + r });
+    int visible = 0, as_moving = 0, as_stopped = 0;
+    for (int y = std::max(0, lo.y); y <= std::min(g.height - 1, hi.y); ++y)
+      for (int x = std::max(0, lo.x); x <= std::min(g.width - 1, hi.x); ++x)
+      {
+        const core::Point2 p = g.cellCentre(core::CellIndex{ x, y });
+        if (!o.contains(p) || truth.cells[g.index(x, y)] != cls) continue;
+        ++visible;
+        const int d = decision.at(p);
+        as_moving += d == kMoving;
+        as_stopped += d == kStopped;
+      }
+    if (visible < min_visible_) continue;
+    if (cls == kMoving)
+    {
+      Track& t = moving_[o.id];
+      if (t.first_visible < 0.0) t.first_visible = stamp;
+      if (t.first_detected < 0.0 && 2 * as_moving > visible) t.first_detected = stamp;
+    }
+    else
+    {
+      ++stopped_pairs_;
+      stopped_moving_ += 2 * as_moving > visible;
+      stopped_stopped_ += 2 * as_stopped > visible;
+    }
+  }
+}
+
+int ObjectScorer::movingVisible() const { return static_cast<int>(moving_.size()); }
+
+int ObjectScorer::movingDetected() const
+{
+  int n = 0;
+  for (const auto& [id, t] : moving_) n += t.first_detected >= 0.0 && t.first_detected - t.first_visible <= window_;
+  return n;
+}
+
+double ObjectScorer::meanDetectionDelay() const
+{
+  double s = 0;
+  int n = 0;
+  for (const auto& [id, t] : moving_)
+    if (t.first_detected >= 0.0)
+    {
+      s += t.first_detected - t.first_visible;
+      ++n;
+    }
+  return n ? s / n : std::nan("");
+}
+
+double ObjectScorer::stoppedCalledMoving() const { return ratio(stopped_moving_, stopped_pairs_); }
+double ObjectScorer::stoppedRecognised() const { return ratio(stopped_stopped_, stopped_pairs_); }
+double ObjectScorer::trailCellsPerScan() const { return ratio(trail_cells_, scans_); }
+double ObjectScorer::trailFraction() const { return ratio(trail_cells_, free_cells_); }
+
+std::map<std::string, double> flatten(const VariantScores& v)
+{
+  std::map<std::string, double> m;
+  for (int c = 0; c < kNumCellClasses; ++c)
+  {
+    const std::string name(core::kCellClassLongNames[c]);
+    m[name + ".precision"] = v.confusion.precision(c);
+    m[name + ".recall"] = v.confusion.recall(c);
+    m[name + ".iou"] = v.confusion.iou(c);
+    m[name + ".support_cells"] = static_cast<double>(v.confusion.support(c));
+  }
+  m["cells.mean_iou"] = v.confusion.meanIou();
+  m["cells.accuracy"] = v.confusion.accuracy();
+  m["cells.coverage"] = v.confusion.coverage();
+  m["objects.moving.visible"] = v.objects.movingVisible();
+  m["objects.moving.detected_within_1s"] = v.objects.movingDetected();
+  m["objects.moving.detection_rate"] = ratio(v.objects.movingDetected(), v.objects.movingVisible());
+  m["objects.moving.mean_detection_delay_s"] = v.objects.meanDetectionDelay();
+  m["objects.stopped.called_moving_rate"] = v.objects.stoppedCalledMoving();
+  m["objects.stopped.recognised_rate"] = v.objects.stoppedRecognised();
+  m["moving.trail_cells_per_scan"] = v.objects.trailCellsPerScan();
+  m["moving.trail_fraction_of_free"] = v.objects.trailFraction();
+  m["scans"] = static_cast<double>(v.scans);
+  return m;
+}
+
+std::string toJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta)
+{
+  std::ostringstream out;
+  out << "{\n  \"meta\": {";
+  bool first = true;
+  for (const auto& [k, v] : meta)
+  {
+    out << (first ? "\n" : ",\n") << "    \"" << escape(k) << "\": \"" << escape(v) << "\"";
+    first = false;
+  }
+  out << "\n  },\n  \"variants\": {";
+  for (std::size_t i = 0; i < variants.size(); ++i)
+  {
+    const auto& v = variants[i];
+    out << (i ? ",\n" : "\n") << "    \"" << escape(v.name) << "\": {\n      \"description\": \"" << escape(v.description)
+        << "\"";
+    for (const auto& [k, x] : flatten(v)) out << ",\n      \"" << k << "\": " << number(x);
+    out << ",\n      \"confusion\": {\"rows_truth\": [\"F\", \"C\", \"N\", \"S\", \"V\"], "
+           "\"columns_decision\": [\"F\", \"C\", \"N\", \"S\", \"V\", \"unknown\"], \"counts\": [";
+    for (int t = 0; t < kNumCellClasses; ++t)
+    {
+      out << (t ? ", [" : "[");
+      for (int d = 0; d <= kNumCellClasses; ++d) out << (d ? ", " : "") << v.confusion.count(t, d);
+      out << "]";
+    }
+    out << "]}\n    }";
+  }
+  out << "\n  }\n}\n";
+  return out.str();
+}
+
+std::string toMarkdown(const std::vector<VariantScores>& variants)
+{
+  std::ostringstream out;
+  out << "| variant | IoU F | IoU C | IoU N | IoU S | IoU V | mean IoU | V recall | V precision | moving objects "
+         "detected ≤ 1 s | stopped called moving | V trail (cells/scan) | coverage |\n";
+  out << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  char buf[64];
+  auto f = [&buf](double v) {
+    std::snprintf(buf, sizeof buf, "%.3f", v);
+    return std::string(buf);
+  };
+  for (const auto& v : variants)
+  {
+    out << "| " << v.name;
+    for (int c = 0; c < kNumCellClasses; ++c) out << " | " << f(v.confusion.iou(c));
+    out << " | " << f(v.confusion.meanIou()) << " | " << f(v.confusion.recall(kMoving)) << " | "
+        << f(v.confusion.precision(kMoving)) << " | " << v.objects.movingDetected() << "/" << v.objects.movingVisible()
+        << " | " << f(v.objects.stoppedCalledMoving()) << " | ";
+    std::snprintf(buf, sizeof buf, "%.1f", v.objects.trailCellsPerScan());
+    out << buf << " | " << f(v.confusion.coverage()) << " |\n";
+  }
+  out << "\n";
+  for (const auto& v : variants) out << "- **" << v.name << "**: " << v.description << "\n";
+  return out.str();
+}
+
+}  // namespace eval
+}  // namespace map_aided_fusion
