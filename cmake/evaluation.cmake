@@ -11,3 +11,10 @@ if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_metrics test/eval/test_metrics.cpp test/test_main.cpp)
   target_link_libraries(test_metrics map_aided_fusion_eval)
 endif()
+
+find_package(yaml-cpp REQUIRED)
+add_executable(evaluate src/tools/evaluate.cpp)
+target_link_libraries(evaluate map_aided_fusion_eval map_aided_fusion_map_io map_aided_fusion_scan_grid_nodelet
+  yaml-cpp ${catkin_LIBRARIES})
+add_dependencies(evaluate ${PROJECT_NAME}_generate_messages_cpp)
+install(TARGETS evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -1,0 +1,619 @@
+// evaluate: runs the core pipeline offline on a scenario bag (no ROS master) with ablation variants,
+// optionally scores a bag recorded from the live nodelets, and writes metrics.json, metrics.md, a per-scan
+// CSV and snapshots (NumPy arrays) for scripts/figures.py.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2/buffer_core.h>
+#include <tf2/utils.h>
+#include <tf2_msgs/TFMessage.h>
+#include <yaml-cpp/yaml.h>
+
+#include "map_aided_fusion/GroundTruthObjectArray.h"
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/prior_grid.hpp"
+#include "map_aided_fusion/core/scan_grid.hpp"
+#include "map_aided_fusion/eval/metrics.hpp"
+#include "map_aided_fusion/map_io/map_loader.hpp"
+#include "map_aided_fusion/ros/point_cloud_view.hpp"
+
+namespace fs = std::filesystem;
+using namespace map_aided_fusion;
+using core::CellClass;
+
+namespace {
+
+constexpr double kStampMatchTolerance = 0.05;  // s between a scan and its ground truth
+constexpr int kProgressWidth = 40;
+
+struct Options
+{
+  std::string bag;
+  std::string output_bag;
+  std::string live_topic = "/map_aided_fusion/decision";
+  std::string out = "out";
+  std::string fusion_config;
+  std::string scan_grid_config;
+  std::string prior_config;
+  std::string map;
+  std::optional<std::array<double, 3>> origin;
+  std::string base_frame = "base_link";
+  std::string map_frame = "map";
+  double snapshot_time = -1.0;  // s after the first scan; < 0: 70 % of the run
+  double sheet_period = 5.0;    // s between contact-sheet frames
+  bool ablations = true;
+  bool quiet = false;
+};
+
+void usage()
+{
+  std::cerr << "usage: evaluate --bag SCENARIO.bag [--output-bag LIVE.bag] [--out DIR]\n"
+               "                [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
+               "                [--map FILE] [--origin LAT,LON[,ALT]] [--snapshot-time S] [--sheet-period S]\n"
+               "                [--no-ablations] [--quiet]\n"
+               "  Runs the pipeline offline on the scenario bag (topics /points, /tf, /tf_static,\n"
+               "  /ground_truth/classes, /ground_truth/objects) with the paper's method and its ablations,\n"
+               "  scores a bag recorded from the live nodelets (topic " "/map_aided_fusion/decision) when given,\n"
+               "  and writes DIR/metrics.json, DIR/metrics.md, DIR/scores.csv and DIR/snapshots/.\n";
+}
+
+// ---- configuration files (the nodelets' YAML files, read without a ROS master) -------------------------
+
+template <typename T>
+void yamlRead(const YAML::Node& n, const char* key, T& value)
+{
+  if (n && n[key]) value = n[key].as<T>();
+}
+
+YAML::Node loadYaml(const std::string& path)
+{
+  if (path.empty()) return YAML::Node();
+  try
+  {
+    return YAML::LoadFile(path);
+  }
+  catch (const YAML::Exception& e)
+  {
+    throw std::runtime_error("cannot read " + path + ": " + e.what());
+  }
+}
+
+core::MapGridParams fusionParams(const YAML::Node& n)
+{
+  core::MapGridParams p;
+  yamlRead(n, "size_x", p.size_x);
+  yamlRead(n, "size_y", p.size_y);
+  yamlRead(n, "resolution", p.resolution);
+  yamlRead(n, "recentre_distance", p.recentre_distance);
+  yamlRead(n, "alpha_static", p.fusion.discount.alpha_static);
+  yamlRead(n, "alpha_dynamic", p.fusion.discount.alpha_dynamic);
+  yamlRead(n, "alpha_free", p.fusion.discount.alpha_free);
+  yamlRead(n, "alpha_per_second", p.rates_per_second);
+  yamlRead(n, "delta_inc", p.fusion.counter.delta_inc);
+  yamlRead(n, "delta_dec", p.fusion.counter.delta_dec);
+  yamlRead(n, "gamma_occupied", p.fusion.counter.gamma_occupied);
+  yamlRead(n, "gamma_conflict", p.fusion.counter.gamma_conflict);
+  bool literal = false;
+  yamlRead(n, "specialise_literal", literal);
+  if (literal) p.fusion.counter.mode = core::SpecialisationMode::kLiteral;
+  yamlRead(n, "decision_threshold", p.decision_threshold);
+  yamlRead(n, "min_object_cells", p.min_object_cells);
+  p.validate();
+  return p;
+}
+
+core::ScanGridParams scanGridParams(const YAML::Node& n)
+{
+  core::ScanGridParams p;
+  yamlRead(n, "grid_resolution", p.grid_resolution);
+  yamlRead(n, "grid_size_x", p.grid_size_x);
+  yamlRead(n, "grid_size_y", p.grid_size_y);
+  yamlRead(n, "grid_offset_x", p.grid_offset_x);
+  yamlRead(n, "grid_offset_y", p.grid_offset_y);
+  yamlRead(n, "azimuth_resolution_deg", p.azimuth_resolution_deg);
+  yamlRead(n, "min_range", p.min_range);
+  yamlRead(n, "max_range", p.max_range);
+  yamlRead(n, "ground_height", p.ground_height);
+  yamlRead(n, "ground_tolerance", p.ground_tolerance);
+  yamlRead(n, "obstacle_min_height", p.obstacle_min_height);
+  yamlRead(n, "obstacle_max_height", p.obstacle_max_height);
+  yamlRead(n, "mu_free", p.mu_free);
+  yamlRead(n, "mu_occupied", p.mu_occupied);
+  yamlRead(n, "free_decay_length", p.free_decay_length);
+  p.validate();
+  return p;
+}
+
+// ---- NumPy .npy writer -----------------------------------------------------------------------------------
+
+template <typename T>
+void writeNpy(const fs::path& path, const T* data, const std::vector<std::size_t>& shape, const char* descr)
+{
+  std::ostringstream header;
+  header << "{'descr': '" << descr << "', 'fortran_order': False, 'shape': (";
+  std::size_t n = 1;
+  for (std::size_t s : shape)
+  {
+    header << s << ", ";
+    n *= s;
+  }
+  header << "), }";
+  std::string h = header.str();
+  const std::size_t total = 10 + h.size() + 1;
+  h.append((64 - total % 64) % 64, ' ');
+  h += '\n';
+  std::ofstream f(path, std::ios::binary);
+  const char magic[] = "\x93NUMPY\x01\x00";
+  f.write(magic, 8);
+  const std::uint16_t len = static_cast<std::uint16_t>(h.size());
+  f.put(static_cast<char>(len & 0xff));
+  f.put(static_cast<char>(len >> 8));
+  f.write(h.data(), static_cast<std::streamsize>(h.size()));
+  f.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(n * sizeof(T)));
+  if (!f) throw std::runtime_error("cannot write " + path.string());
+}
+
+// ---- ground truth ----------------------------------------------------------------------------------------
+
+std::int64_t key(const ros::Time& t) { return static_cast<std::int64_t>(t.toNSec()); }
+
+template <typename V>
+const V* nearest(const std::map<std::int64_t, V>& m, const ros::Time& t)
+{
+  if (m.empty()) return nullptr;
+  const std::int64_t k = key(t);
+  auto it = m.lower_bound(k);
+  const V* best = nullptr;
+  double best_dt = kStampMatchTolerance;
+  auto consider = [&](typename std::map<std::int64_t, V>::const_iterator i) {
+    const double dt = std::abs(static_cast<double>(i->first - k)) * 1e-9;
+    if (dt <= best_dt)
+    {
+      best_dt = dt;
+      best = &i->second;
+    }
+  };
+  if (it != m.end()) consider(it);
+  if (it != m.begin()) consider(std::prev(it));
+  return best;
+}
+
+eval::ClassGrid fromOccupancy(const nav_msgs::OccupancyGrid& g)
+{
+  eval::ClassGrid c;
+  c.geometry = core::GridGeometry{ g.info.resolution, static_cast<int>(g.info.width), static_cast<int>(g.info.height),
+                                   g.info.origin.position.x, g.info.origin.position.y };
+  c.cells = g.data;
+  if (c.cells.size() != c.geometry.numCells()) throw std::runtime_error("ground truth grid with a wrong data size");
+  return c;
+}
+
+std::vector<eval::TruthObject> fromObjects(const GroundTruthObjectArray& a)
+{
+  std::vector<eval::TruthObject> out;
+  for (const auto& o : a.objects)
+  {
+    eval::TruthObject t;
+    t.id = o.id;
+    t.cell_class = static_cast<CellClass>(o.cell_class);
+    t.kind = o.kind;
+    t.centre = core::Point2{ o.pose.position.x, o.pose.position.y };
+    t.yaw = tf2::getYaw(o.pose.orientation);
+    t.length = o.size.x;
+    t.width = o.size.y;
+    t.speed = std::hypot(o.velocity.x, o.velocity.y);
+    out.push_back(t);
+  }
+  return out;
+}
+
+// ---- pipeline variants -----------------------------------------------------------------------------------
+
+struct Variant
+{
+  eval::VariantScores scores;
+  core::MapGrid grid;
+  bool use_prior;
+  eval::ClassGrid decision;
+  Variant(const std::string& name, const std::string& description, const core::MapGridParams& p, bool prior)
+    : grid(p), use_prior(prior)
+  {
+    scores.name = name;
+    scores.description = description;
+  }
+};
+
+void progress(bool quiet, std::size_t done, std::size_t total, const char* what)
+{
+  if (quiet || total == 0) return;
+  const int filled = static_cast<int>(kProgressWidth * done / total);
+  std::fprintf(stderr, "\r%-10s [%s%s] %zu/%zu", what, std::string(filled, '#').c_str(),
+               std::string(kProgressWidth - filled, ' ').c_str(), done, total);
+  if (done == total) std::fprintf(stderr, "\n");
+}
+
+double argDouble(const std::string& name, const std::string& v)
+{
+  try
+  {
+    std::size_t used = 0;
+    const double d = std::stod(v, &used);
+    if (used != v.size()) throw std::invalid_argument(v);
+    return d;
+  }
+  catch (const std::exception&)
+  {
+    throw std::runtime_error(name + ": not a number: " + v);
+  }
+}
+
+Options parse(int argc, char** argv)
+{
+  Options o;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--bag") o.bag = value();
+    else if (a == "--output-bag") o.output_bag = value();
+    else if (a == "--live-topic") o.live_topic = value();
+    else if (a == "--out") o.out = value();
+    else if (a == "--fusion-config") o.fusion_config = value();
+    else if (a == "--scan-grid-config") o.scan_grid_config = value();
+    else if (a == "--prior-config") o.prior_config = value();
+    else if (a == "--map") o.map = value();
+    else if (a == "--origin")
+    {
+      std::stringstream ss(value());
+      std::array<double, 3> v{ 0, 0, 0 };
+      std::string part;
+      int k = 0;
+      while (std::getline(ss, part, ',') && k < 3) v[k++] = argDouble("--origin", part);
+      if (k < 2) throw std::runtime_error("--origin needs LAT,LON[,ALT]");
+      o.origin = v;
+    }
+    else if (a == "--snapshot-time") o.snapshot_time = argDouble(a, value());
+    else if (a == "--sheet-period") o.sheet_period = argDouble(a, value());
+    else if (a == "--no-ablations") o.ablations = false;
+    else if (a == "--quiet") o.quiet = true;
+    else if (a == "-h" || a == "--help")
+    {
+      usage();
+      std::exit(0);
+    }
+    else
+      throw std::runtime_error("unknown argument " + a);
+  }
+  if (o.bag.empty()) throw std::runtime_error("--bag is required");
+  return o;
+}
+
+core::PriorWindow loadPrior(const Options& o, const YAML::Node& prior_cfg, double resolution, std::string& summary)
+{
+  map_io::MapLoadParams lp;
+  lp.file = o.map;
+  if (lp.file.empty()) yamlRead(prior_cfg, "map_file", lp.file);
+  if (lp.file.empty()) throw std::runtime_error("no map: give --map or map_file in the prior config");
+  yamlRead(prior_cfg, "origin_latitude", lp.origin_latitude);
+  yamlRead(prior_cfg, "origin_longitude", lp.origin_longitude);
+  yamlRead(prior_cfg, "origin_altitude", lp.origin_altitude);
+  yamlRead(prior_cfg, "metric", lp.metric);
+  if (o.origin)
+  {
+    lp.origin_latitude = (*o.origin)[0];
+    lp.origin_longitude = (*o.origin)[1];
+    lp.origin_altitude = (*o.origin)[2];
+  }
+  core::PriorConfidence beta;
+  yamlRead(prior_cfg, "beta_building", beta.beta_building);
+  yamlRead(prior_cfg, "beta_road", beta.beta_road);
+  yamlRead(prior_cfg, "beta_other", beta.beta_other);
+  beta.validate();
+  map_io::MapLoadReport report;
+  const core::VectorMap vm = map_io::loadVectorMap(lp, &report);
+  const core::PriorGrid grid = core::PriorGrid::fromVectorMap(vm, resolution);
+  core::PriorWindow window;
+  grid.fillWindow(grid.geometry(), beta, window);
+  summary = lp.file + ": " + std::to_string(vm.buildings.size()) + " buildings, " +
+            std::to_string(vm.road_areas.size()) + " road surfaces";
+  return window;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  Options opt;
+  try
+  {
+    opt = parse(argc, argv);
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "evaluate: " << e.what() << "\n";
+    usage();
+    return 2;
+  }
+  try
+  {
+    const YAML::Node fusion_cfg = loadYaml(opt.fusion_config);
+    const YAML::Node scan_cfg = loadYaml(opt.scan_grid_config);
+    const YAML::Node prior_cfg = loadYaml(opt.prior_config);
+    const core::MapGridParams params = fusionParams(fusion_cfg);
+    const core::ScanGridParams scan_params = scanGridParams(scan_cfg);
+    std::string prior_summary;
+    const core::PriorWindow prior = loadPrior(opt, prior_cfg, params.resolution, prior_summary);
+
+    // Pass 1: tf, ground truth.
+    rosbag::Bag bag;
+    bag.open(opt.bag, rosbag::bagmode::Read);
+    tf2::BufferCore tf(ros::Duration(1e6));
+    std::map<std::int64_t, eval::ClassGrid> truth;
+    std::map<std::int64_t, std::vector<eval::TruthObject>> truth_objects;
+    std::size_t clouds = 0;
+    {
+      rosbag::View view(bag);
+      for (const rosbag::MessageInstance& m : view)
+      {
+        const std::string& topic = m.getTopic();
+        if (topic == "/tf" || topic == "/tf_static")
+        {
+          if (auto msg = m.instantiate<tf2_msgs::TFMessage>())
+            for (const auto& t : msg->transforms) tf.setTransform(t, "bag", topic == "/tf_static");
+        }
+        else if (topic == "/ground_truth/classes")
+        {
+          if (auto msg = m.instantiate<nav_msgs::OccupancyGrid>()) truth[key(msg->header.stamp)] = fromOccupancy(*msg);
+        }
+        else if (topic == "/ground_truth/objects")
+        {
+          if (auto msg = m.instantiate<GroundTruthObjectArray>())
+            truth_objects[key(msg->header.stamp)] = fromObjects(*msg);
+        }
+        else if (topic == "/points")
+        {
+          ++clouds;
+        }
+      }
+    }
+    if (clouds == 0) throw std::runtime_error(opt.bag + " has no /points");
+    if (truth.empty()) throw std::runtime_error(opt.bag + " has no /ground_truth/classes");
+
+    std::vector<std::unique_ptr<Variant>> variants;
+    variants.push_back(std::make_unique<Variant>("full", "the paper's method: prior, contextual discounting, modified "
+                                                         "Yager rule, counter and specialisation",
+                                                 params, true));
+    core::MapGridParams p = params;
+    variants.push_back(std::make_unique<Variant>("no_prior", "as full, with a vacuous PriorGrid", params, false));
+    if (opt.ablations)
+    {
+      p = params;
+      p.fusion.rule = core::CombinationRule::kDempster;
+      variants.push_back(std::make_unique<Variant>("dempster", "Dempster's rule instead of the modified Yager rule", p, true));
+      p = params;
+      p.fusion.rule = core::CombinationRule::kYager;
+      variants.push_back(std::make_unique<Variant>("yager", "Yager's rule (all conflict to Omega) instead of the modified "
+                                                            "Yager rule",
+                                                   p, true));
+      p = params;
+      p.fusion.contextual_discounting = false;
+      p.fusion.alpha_single = params.fusion.discount.alpha_free;
+      variants.push_back(std::make_unique<Variant>(
+          "single_rate", "classical discounting with one rate (alpha_free) instead of contextual discounting", p, true));
+      p = params;
+      p.fusion.use_counter = false;
+      variants.push_back(std::make_unique<Variant>("no_counter", "no counter zeta and no specialisation", p, true));
+    }
+
+    fs::create_directories(fs::path(opt.out) / "snapshots");
+    std::ofstream csv(fs::path(opt.out) / "scores.csv");
+    csv << "time_s,variant,scan_compared_cells";
+    for (const auto& n : core::kCellClassLongNames) csv << "," << n << "_recall";
+    csv << ",accuracy\n";
+
+    // Pass 2: scans.
+    core::ScanGridBuilder builder;
+    bool builder_ready = false;
+    core::ScanMassGrid scan;
+    std::optional<double> t0;
+    std::size_t done = 0, no_truth = 0, no_pose = 0;
+    double snapshot_at = -1.0, next_sheet = 0.0;
+    int sheet_frame = 0;
+    const double duration_guess = [&] {
+      rosbag::View v(bag, rosbag::TopicQuery(std::vector<std::string>{ "/points" }));
+      return (v.getEndTime() - v.getBeginTime()).toSec();
+    }();
+    const double snapshot_time = opt.snapshot_time >= 0.0 ? opt.snapshot_time : 0.7 * duration_guess;
+    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{ "/points" }));
+    for (const rosbag::MessageInstance& m : view)
+    {
+      auto cloud = m.instantiate<sensor_msgs::PointCloud2>();
+      progress(opt.quiet, ++done, clouds, "scans");
+      if (!cloud) continue;
+      geometry_msgs::TransformStamped base, sensor;
+      try
+      {
+        base = tf.lookupTransform(opt.map_frame, opt.base_frame, cloud->header.stamp);
+        sensor = tf.lookupTransform(opt.base_frame, cloud->header.frame_id, ros::Time(0));
+      }
+      catch (const tf2::TransformException&)
+      {
+        ++no_pose;
+        continue;
+      }
+      if (!builder_ready)
+      {
+        Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
+        const auto& q = sensor.transform.rotation;
+        s.linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+        s.translation() =
+            Eigen::Vector3d(sensor.transform.translation.x, sensor.transform.translation.y, sensor.transform.translation.z);
+        builder.configure(scan_params, s);
+        builder_ready = true;
+      }
+      core::PointCloudView pv;
+      std::string detail;
+      if (makePointCloudView(*cloud, pv, &detail) != CloudRejection::kNone)
+        throw std::runtime_error("unreadable cloud in " + opt.bag + ": " + detail);
+      builder.build(pv, scan);
+      const double t = cloud->header.stamp.toSec();
+      if (!t0) t0 = t;
+      const core::Pose2 pose{ base.transform.translation.x, base.transform.translation.y,
+                              tf2::getYaw(base.transform.rotation) };
+      const eval::ClassGrid* gt = nearest(truth, cloud->header.stamp);
+      const auto* objects = nearest(truth_objects, cloud->header.stamp);
+      if (!gt) ++no_truth;
+      const bool snapshot = snapshot_at < 0.0 && t - *t0 >= snapshot_time;
+      const bool sheet = t - *t0 >= next_sheet;
+      for (auto& v : variants)
+      {
+        v->grid.update(scan, pose, t, v->use_prior ? &prior : nullptr);
+        v->decision.geometry = v->grid.geometry();
+        core::decide(v->grid.masses(), v->grid.pignistic(), v->grid.params().decision_threshold, v->decision.cells);
+        if (!gt) continue;
+        eval::ConfusionMatrix scan_confusion;
+        const auto compared = eval::accumulate(*gt, v->decision, scan_confusion);
+        v->scores.confusion.add(scan_confusion);
+        v->scores.objects.add(t, *gt, objects ? *objects : std::vector<eval::TruthObject>{}, v->decision);
+        ++v->scores.scans;
+        csv << (t - *t0) << "," << v->scores.name << "," << compared;
+        for (int c = 0; c < core::kNumCellClasses; ++c)
+          csv << "," << (scan_confusion.support(c) ? std::to_string(scan_confusion.recall(c)) : "");
+        csv << "," << scan_confusion.accuracy() << "\n";
+      }
+      if ((snapshot || sheet) && gt)
+      {
+        const fs::path dir = fs::path(opt.out) / "snapshots";
+        auto dumpDecision = [&](const Variant& v, const std::string& name) {
+          const auto& g = v.grid.geometry();
+          writeNpy(dir / (name + "_decision.npy"), v.decision.cells.data(),
+                   { static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "|i1");
+        };
+        auto geometryJson = [](const core::GridGeometry& g) {
+          std::ostringstream s;
+          s << "{\"resolution\": " << g.resolution << ", \"width\": " << g.width << ", \"height\": " << g.height
+            << ", \"origin_x\": " << g.origin_x << ", \"origin_y\": " << g.origin_y << "}";
+          return s.str();
+        };
+        const std::string stem = snapshot ? "figure" : "sheet_" + std::to_string(sheet_frame);
+        dumpDecision(*variants[0], stem + "_with_prior");
+        writeNpy(dir / (stem + "_truth.npy"), gt->cells.data(),
+                 { static_cast<std::size_t>(gt->geometry.height), static_cast<std::size_t>(gt->geometry.width) }, "|i1");
+        std::ofstream meta(dir / (stem + ".json"));
+        meta << "{\"time_s\": " << (t - *t0) << ", \"ego\": {\"x\": " << pose.x << ", \"y\": " << pose.y
+             << ", \"yaw\": " << pose.yaw << "}, \"grid\": " << geometryJson(variants[0]->grid.geometry())
+             << ", \"truth_grid\": " << geometryJson(gt->geometry) << ", \"objects\": [";
+        if (objects)
+          for (std::size_t k = 0; k < objects->size(); ++k)
+          {
+            const auto& o = (*objects)[k];
+            meta << (k ? ", " : "") << "{\"id\": " << o.id << ", \"class\": " << static_cast<int>(o.cell_class)
+                 << ", \"kind\": \"" << o.kind << "\", \"x\": " << o.centre.x << ", \"y\": " << o.centre.y
+                 << ", \"yaw\": " << o.yaw << ", \"length\": " << o.length << ", \"width\": " << o.width
+                 << ", \"speed\": " << o.speed << "}";
+          }
+        meta << "]}\n";
+        if (snapshot)
+        {
+          snapshot_at = t - *t0;
+          for (const auto& v : variants)
+          {
+            if (v->scores.name != "full" && v->scores.name != "no_prior") continue;
+            const auto& g = v->grid.geometry();
+            std::vector<float> planes;
+            for (int e = 0; e < core::FrameMG::kSize; ++e)
+              planes.insert(planes.end(), v->grid.pignistic()[e].begin(), v->grid.pignistic()[e].end());
+            writeNpy(dir / ("figure_" + v->scores.name + "_betp.npy"), planes.data(),
+                     { 5, static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "<f4");
+            dumpDecision(*v, "figure_" + v->scores.name);
+          }
+          // The prior over the MapGrid window.
+          const auto& g = variants[0]->grid.geometry();
+          core::PriorWindow w;
+          core::extractPriorWindow(prior, g, w);
+          std::vector<std::int8_t> labels(g.numCells());
+          for (std::size_t i = 0; i < labels.size(); ++i)
+            labels[i] = w.building[i] > 0.0f ? 1 : w.road[i] > 0.0f ? 2 : w.other[i] > 0.0f ? 3 : 0;
+          writeNpy(dir / "figure_prior.npy", labels.data(),
+                   { static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "|i1");
+        }
+        if (sheet)
+        {
+          ++sheet_frame;
+          next_sheet += opt.sheet_period;
+        }
+      }
+    }
+    bag.close();
+
+    std::vector<eval::VariantScores> scores;
+    for (const auto& v : variants) scores.push_back(v->scores);
+
+    // The live nodelets' decisions, when recorded.
+    if (!opt.output_bag.empty())
+    {
+      rosbag::Bag live;
+      live.open(opt.output_bag, rosbag::bagmode::Read);
+      eval::VariantScores s;
+      s.name = "live";
+      s.description = "the three nodelets running on the replayed bag (rosbag play --clock), decisions recorded from " +
+                      opt.live_topic;
+      rosbag::View lv(live, rosbag::TopicQuery(std::vector<std::string>{ opt.live_topic }));
+      const std::size_t total = lv.size();
+      std::size_t k = 0;
+      for (const rosbag::MessageInstance& m : lv)
+      {
+        progress(opt.quiet, ++k, total, "live");
+        auto d = m.instantiate<nav_msgs::OccupancyGrid>();
+        if (!d) continue;
+        const eval::ClassGrid* gt = nearest(truth, d->header.stamp);
+        if (!gt) continue;
+        const eval::ClassGrid decision = fromOccupancy(*d);
+        eval::accumulate(*gt, decision, s.confusion);
+        const auto* objects = nearest(truth_objects, d->header.stamp);
+        s.objects.add(d->header.stamp.toSec(), *gt, objects ? *objects : std::vector<eval::TruthObject>{}, decision);
+        ++s.scans;
+      }
+      if (s.scans == 0) std::cerr << "evaluate: no decision of " << opt.output_bag << " matches the ground truth\n";
+      scores.push_back(s);
+    }
+
+    std::map<std::string, std::string> meta{ { "scenario_bag", opt.bag },
+                                             { "prior", prior_summary },
+                                             { "scans", std::to_string(done) },
+                                             { "scans_without_pose", std::to_string(no_pose) },
+                                             { "scans_without_ground_truth", std::to_string(no_truth) },
+                                             { "figure_time_s", std::to_string(snapshot_at) } };
+    std::ofstream(fs::path(opt.out) / "metrics.json") << eval::toJson(scores, meta);
+    std::ofstream(fs::path(opt.out) / "metrics.md") << "# map_aided_fusion evaluation\n\nScenario: `" << opt.bag
+                                                     << "`, " << done << " scans.\n\n"
+                                                     << eval::toMarkdown(scores);
+    std::cout << eval::toMarkdown(scores);
+    std::cout << "wrote " << (fs::path(opt.out) / "metrics.json").string() << ", metrics.md, scores.csv, snapshots/\n";
+    return 0;
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "\nevaluate: " << e.what() << "\n";
+    return 1;
+  }
+}
