@@ -129,7 +129,9 @@ struct MapLoadReport
   std::size_t excluded_tunnels = 0;        ///< drivable roads left out because they are tunnels
   std::size_t skipped_geometries = 0;      ///< total skipped (the sum of the counts below)
   std::size_t skipped_unclosed = 0;        ///< building/road-area ways that are not closed rings
-  std::size_t skipped_missing_nodes = 0;   ///< ways with nodes missing from the extract
+  std::size_t skipped_missing_nodes = 0;   ///< ways with nodes missing from the extract (OSM: ways of any kind
+                                           ///< the reader dropped with < 2 nodes are included)
+  std::size_t skipped_incomplete_relations = 0;  ///< OSM relations (any kind) ignored: member ways missing
   std::size_t skipped_degenerate = 0;      ///< fewer than 3 distinct vertices (polygons) or 2 (lines), NaN
   std::size_t skipped_invalid = 0;         ///< invalid polygons not repaired
   std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance from the origin
