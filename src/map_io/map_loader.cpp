@@ -31,6 +31,8 @@ namespace {
 
 constexpr std::size_t kMaxReportMessages = 20;
 constexpr double kFeetToMetres = 0.3048;
+/// A `lanes` value above this is a tagging error (ignored).
+constexpr long kMaxLanes = 64;
 constexpr double kMaxLatitude = 90.0;
 constexpr double kMaxLongitude = 180.0;
 constexpr double kMetresPerKilometre = 1000.0;
@@ -98,7 +100,7 @@ int parseCount(const std::string& text)
   const char* begin = text.c_str();
   char* end = nullptr;
   const long v = std::strtol(begin, &end, 10);
-  if (end == begin || v <= 0 || v > 1000) return 0;
+  if (end == begin || v <= 0 || v > kMaxLanes) return 0;
   return static_cast<int>(v);
 }
 
