@@ -51,7 +51,8 @@ if(CATKIN_ENABLE_TESTING)
     MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 
   catkin_add_gtest(test_prior_grid_params test/prior/test_prior_grid_params.cpp test/test_main.cpp)
-  target_link_libraries(test_prior_grid_params map_aided_fusion_map_io)
+  target_link_libraries(test_prior_grid_params map_aided_fusion_map_io yaml-cpp)
+  target_compile_definitions(test_prior_grid_params PRIVATE MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 
   # rostest: latched prior received by a late subscriber; a bad map path is reported and the node stays alive.
   add_executable(test_prior_grid_ros EXCLUDE_FROM_ALL test/prior/test_prior_grid_ros.cpp)
@@ -70,6 +71,7 @@ if(TARGET bench_map_aided_fusion)
 endif()
 
 # ---- Command-line tool (ROS-free) -----------------------------------------------------------------
+find_package(yaml-cpp REQUIRED)
 add_executable(prior_grid_tool src/tools/prior_grid_tool.cpp)
-target_link_libraries(prior_grid_tool map_aided_fusion_map_io)
+target_link_libraries(prior_grid_tool map_aided_fusion_map_io yaml-cpp)
 install(TARGETS prior_grid_tool RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -31,6 +31,8 @@ namespace {
 
 constexpr std::size_t kMaxReportMessages = 20;
 constexpr double kFeetToMetres = 0.3048;
+/// A `lanes` value above this is a tagging error (ignored).
+constexpr long kMaxLanes = 64;
 constexpr double kMaxLatitude = 90.0;
 constexpr double kMaxLongitude = 180.0;
 constexpr double kMetresPerKilometre = 1000.0;
@@ -98,7 +100,7 @@ int parseCount(const std::string& text)
   const char* begin = text.c_str();
   char* end = nullptr;
   const long v = std::strtol(begin, &end, 10);
-  if (end == begin || v <= 0 || v > 1000) return 0;
+  if (end == begin || v <= 0 || v > kMaxLanes) return 0;
   return static_cast<int>(v);
 }
 
@@ -179,8 +181,10 @@ public:
   const std::string& last() const { return last_; }
   /// Errors (CE_Failure or worse) reported by GDAL so far.
   std::size_t failures() const { return failures_; }
-  /// Ways the OSM driver dropped because fewer than 2 of their nodes are in the extract.
-  std::size_t discardedWays() const { return discarded_ways_; }
+  /// Ids ("way/N") of ways the OSM driver dropped: fewer than 2 of their nodes in the file or the extract.
+  const std::vector<std::string>& discardedWays() const { return discarded_ways_; }
+  /// Ids ("relation/N") of relations the OSM driver ignored because member ways are missing from the extract.
+  const std::vector<std::string>& incompleteRelations() const { return incomplete_relations_; }
   /// Ways the OSM driver shortened because some of their nodes are missing from the extract.
   bool truncated(long long way_id) const { return truncated_ways_.count(way_id) > 0; }
 
@@ -197,8 +201,10 @@ private:
       const char* text = std::strstr(msg, "For way ");
       if (text != nullptr && std::sscanf(text, "For way %lld, got only %d nodes instead of %d", &id, &got, &want) == 3)
         self->truncated_ways_.insert(id);
-      else if (m.find("nodes that could be found. Discarding it") != std::string::npos)
-        ++self->discarded_ways_;
+      else if (m.find("Way ") != std::string::npos && m.find("Discarding it") != std::string::npos)
+        self->remember(self->discarded_ways_, m, "Way ", "way/");
+      else if (m.find("has missing ways") != std::string::npos)
+        self->remember(self->incomplete_relations_, m, "Relation ", "relation/");
       return;
     }
     self->last_ = m;
@@ -207,7 +213,18 @@ private:
   std::string last_;
   std::string saved_debug_;
   bool had_debug_ = false;
-  std::size_t discarded_ways_ = 0;
+  static void remember(std::vector<std::string>& ids, const std::string& m, const char* prefix, const char* kind)
+  {
+    const std::size_t at = m.find(prefix);
+    long long id = 0;
+    if (at != std::string::npos && std::sscanf(m.c_str() + at + std::strlen(prefix), "%lld", &id) == 1)
+      ids.push_back(kind + std::to_string(id));
+    else
+      ids.push_back(std::string(kind) + "?");
+  }
+
+  std::vector<std::string> discarded_ways_;
+  std::vector<std::string> incomplete_relations_;
   std::size_t failures_ = 0;
   std::set<long long> truncated_ways_;
 };
@@ -607,11 +624,15 @@ private:
         addPolygonal(id, Role::kRoadArea, g, 0.0);
     }
     // Ways GDAL's OSM driver dropped because their nodes were missing (reported only through CPLDebug).
-    if (errors_.discardedWays() > 0)
+    for (const std::string& id : errors_.discardedWays())
     {
-      r_.skipped_missing_nodes += errors_.discardedWays();
-      note("ways", std::to_string(errors_.discardedWays()) +
-                       " ways (of any kind) discarded by the reader: fewer than 2 of their nodes in the extract");
+      ++r_.skipped_missing_nodes;
+      note(id, "way (of any kind) dropped by the reader: fewer than 2 of its nodes in the file");
+    }
+    for (const std::string& id : errors_.incompleteRelations())
+    {
+      ++r_.skipped_incomplete_relations;
+      note(id, "relation (of any kind) ignored by the reader: member ways missing from the extract");
     }
   }
 
@@ -736,8 +757,8 @@ private:
     r_.buildings = out_.buildings.size();
     r_.road_areas = out_.road_areas.size();
     r_.road_lines = out_.road_lines.size();
-    r_.skipped_geometries = r_.skipped_unclosed + r_.skipped_missing_nodes + r_.skipped_degenerate +
-                            r_.skipped_invalid + r_.skipped_out_of_range;
+    r_.skipped_geometries = r_.skipped_unclosed + r_.skipped_missing_nodes + r_.skipped_incomplete_relations +
+                            r_.skipped_degenerate + r_.skipped_invalid + r_.skipped_out_of_range;
     out_.skipped_geometries = r_.skipped_geometries;
   }
 
@@ -835,6 +856,7 @@ std::string summary(const MapLoadReport& r)
     << r.features_read << " features read; kept " << r.buildings << " buildings, " << r.road_areas
     << " road areas, " << r.road_lines << " road lines (" << r.excluded_tunnels << " tunnels left out); repaired " << r.repaired_geometries << "; skipped "
     << r.skipped_geometries << " (unclosed " << r.skipped_unclosed << ", missing nodes " << r.skipped_missing_nodes
+    << ", incomplete relations " << r.skipped_incomplete_relations
     << ", degenerate " << r.skipped_degenerate << ", invalid " << r.skipped_invalid << ", out of range "
     << r.skipped_out_of_range << ")";
   if (r.read_errors > 0) s << "; " << r.read_errors << " read errors: the map may be incomplete";

@@ -1,7 +1,6 @@
 #include "map_aided_fusion/ros/prior_grid_node.hpp"
 
 #include <algorithm>
-#include <map>
 #include <vector>
 
 #include <geometry_msgs/Point.h>
@@ -27,12 +26,6 @@ struct Rgba
 constexpr Rgba kBuildingColour{ 0.0f, 0.0f, 1.0f, 1.0f };
 constexpr Rgba kRoadAreaColour{ 1.0f, 1.0f, 1.0f, 1.0f };
 constexpr Rgba kRoadLineColour{ 0.8f, 0.8f, 0.8f, 1.0f };
-
-template <class T>
-void param(const ros::NodeHandle& pnh, const std::string& name, T& value)
-{
-  pnh.param(name, value, value);
-}
 
 bool inside(const core::GridGeometry& g, const core::Point2& p)
 {
@@ -87,47 +80,11 @@ visualization_msgs::Marker lineList(const std_msgs::Header& header, const std::s
 map_io::PriorGridParams readPriorGridParams(const ros::NodeHandle& pnh)
 {
   map_io::PriorGridParams p;
-  map_io::MapLoadParams& m = p.map;
-  param(pnh, "map_file", m.file);
-  std::string source = map_io::toString(m.source);
-  param(pnh, "source", source);
-  m.source = map_io::parseMapSourceKind(source);
-  param(pnh, "origin_latitude", m.origin_latitude);
-  param(pnh, "origin_longitude", m.origin_longitude);
-  param(pnh, "origin_altitude", m.origin_altitude);
-  param(pnh, "metric", m.metric);
-  param(pnh, "max_origin_distance", m.max_origin_distance);
-  param(pnh, "building_layer", m.building_layer);
-  param(pnh, "road_layer", m.road_layer);
-  param(pnh, "road_area_layer", m.road_area_layer);
-  param(pnh, "building_attribute", m.building_attribute);
-  param(pnh, "building_height_attribute", m.building_height_attribute);
-  param(pnh, "building_levels_attribute", m.building_levels_attribute);
-  param(pnh, "road_class_attribute", m.road_class_attribute);
-  param(pnh, "road_width_attribute", m.road_width_attribute);
-  param(pnh, "road_lanes_attribute", m.road_lanes_attribute);
-  param(pnh, "road_area_attribute", m.road_area_attribute);
-  param(pnh, "road_tunnel_attribute", m.road_tunnel_attribute);
-  param(pnh, "exclude_tunnels", m.exclude_tunnels);
-  param(pnh, "drivable_classes", m.drivable_classes);
-  param(pnh, "lane_width", m.lane_width);
-  param(pnh, "level_height", m.level_height);
-  param(pnh, "default_road_width", m.default_road_width);
-  std::map<std::string, double> widths;
-  if (pnh.getParam("road_class_widths", widths))
-    for (const auto& kv : widths) m.road_class_widths[kv.first] = kv.second;
-  param(pnh, "repair_invalid", m.repair_invalid);
-  param(pnh, "frame_id", p.frame_id);
-  param(pnh, "resolution", p.resolution);
-  param(pnh, "beta_building", p.beta.beta_building);
-  param(pnh, "beta_road", p.beta.beta_road);
-  param(pnh, "beta_other", p.beta.beta_other);
-  param(pnh, "margin", p.margin);
-  param(pnh, "publish_size", p.publish_size);
-  param(pnh, "publish_centre_x", p.publish_centre_x);
-  param(pnh, "publish_centre_y", p.publish_centre_y);
-  param(pnh, "max_published_cells", p.max_published_cells);
-  param(pnh, "publish_outlines", p.publish_outlines);
+  map_io::forEachPriorGridParam(p, [&pnh](const std::string& name, auto& value) {
+    if (!pnh.hasParam(name)) return;
+    if (!pnh.getParam(name, value))
+      throw core::ParameterError(name, "has the wrong type (see config/prior_grid.yaml)");
+  });
   return p;
 }
 

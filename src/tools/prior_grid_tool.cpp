@@ -1,6 +1,6 @@
 // prior_grid_tool: loads a map as the PriorGridNodelet does, prints what it read and the cells per class,
 // and optionally writes a PNG of the prior in the paper's colours. ROS-free.
-//   prior_grid_tool --map FILE [--origin LAT,LON[,ALT]] [--resolution R] [--png OUT.png] [--source KIND]
+//   prior_grid_tool [--config config/prior_grid.yaml] --map FILE [--origin LAT,LON[,ALT]] [--resolution R] [--png OUT.png] [--source KIND]
 //                   [--metric] [--margin M] [--size S [--centre X,Y]] [--max-cells N]
 #include <chrono>
 #include <cmath>
@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <yaml-cpp/yaml.h>
 
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
@@ -26,9 +28,10 @@ constexpr int kExitUsage = 2;
 
 void usage(std::ostream& os)
 {
-  os << "usage: prior_grid_tool --map FILE [--origin LAT,LON[,ALT]] [--resolution R] [--png OUT.png]\n"
+  os << "usage: prior_grid_tool [--config YAML] --map FILE [--origin LAT,LON[,ALT]] [--resolution R] [--png OUT.png]\n"
         "                       [--source auto|osm|geojson|shapefile|gpkg] [--metric] [--margin M]\n"
         "                       [--size S [--centre X,Y]] [--max-cells N]\n"
+        "  --config YAML        parameters as in config/prior_grid.yaml (options given after it override them)\n"
         "  --map FILE           OpenStreetMap (.osm, .osm.pbf), GeoJSON, Shapefile or GeoPackage map\n"
         "  --origin LAT,LON,ALT origin of the map frame, degrees and metres (default: centre of the data)\n"
         "  --resolution R       cell side in metres (default 0.5)\n"
@@ -64,6 +67,32 @@ bool parseOrigin(const std::string& s, map_io::MapLoadParams& p)
   return true;
 }
 
+/// Reads the keys of config/prior_grid.yaml from a YAML file into @p p (absent keys keep their values).
+void readYaml(const std::string& path, map_io::PriorGridParams& p)
+{
+  YAML::Node root;
+  try
+  {
+    root = YAML::LoadFile(path);
+  }
+  catch (const YAML::Exception& e)
+  {
+    throw std::runtime_error("config '" + path + "': " + e.what());
+  }
+  map_io::forEachPriorGridParam(p, [&root](const std::string& name, auto& value) {
+    const YAML::Node n = root[name];
+    if (!n) return;
+    try
+    {
+      value = n.as<std::remove_reference_t<decltype(value)>>();
+    }
+    catch (const YAML::Exception&)
+    {
+      throw core::ParameterError(name, "has the wrong type (see config/prior_grid.yaml)");
+    }
+  });
+}
+
 double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b)
 {
   return std::chrono::duration<double>(b - a).count();
@@ -73,8 +102,12 @@ double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_cloc
 
 int main(int argc, char** argv)
 {
-  map_io::MapLoadParams params;
-  double resolution = kDefaultResolution, margin = 0.0, max_cells = kDefaultMaxCells, size = 0.0;
+  map_io::PriorGridParams all;
+  all.resolution = kDefaultResolution;
+  map_io::MapLoadParams& params = all.map;
+  double& resolution = all.resolution;
+  double& margin = all.margin;
+  double max_cells = kDefaultMaxCells, size = 0.0;
   std::vector<double> centre{ 0.0, 0.0 };
   std::string png;
   for (int i = 1; i < argc; ++i)
@@ -100,6 +133,20 @@ int main(int argc, char** argv)
       ok = false;
     else if (a == "--map")
       params.file = value();
+    else if (a == "--config")
+    {
+      try
+      {
+        const std::string map_file = params.file;
+        readYaml(value(), all);
+        if (!map_file.empty()) params.file = map_file;  // --map given before --config wins
+      }
+      catch (const std::exception& e)
+      {
+        std::cerr << "prior_grid_tool: " << e.what() << "\n";
+        return kExitUsage;
+      }
+    }
     else if (a == "--origin")
       ok = parseOrigin(value(), params);
     else if (a == "--resolution")
@@ -147,6 +194,7 @@ int main(int argc, char** argv)
   try
   {
     core::requirePositive("resolution", resolution);
+    all.beta.validate();
     const auto t0 = std::chrono::steady_clock::now();
     map_io::MapLoadReport report;
     const core::VectorMap map = map_io::loadVectorMap(params, &report);

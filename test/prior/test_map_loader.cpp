@@ -130,6 +130,34 @@ TEST(MapLoader, WayWithMissingNodeIsSkippedAndCounted)
   EXPECT_NE(report.messages[0].find("way/7"), std::string::npos);
 }
 
+TEST(MapLoader, IncompleteRelationsAndOneNodeWaysAreCounted)
+{
+  const std::string osm = R"(<?xml version="1.0"?><osm version="0.6">
+  <node id="1" lat="49.0000" lon="2.0000"/><node id="2" lat="49.0001" lon="2.0000"/>
+  <node id="3" lat="49.0001" lon="2.0001"/><node id="4" lat="49.0000" lon="2.0001"/>
+  <way id="10"><nd ref="1"/><nd ref="2"/><nd ref="3"/><nd ref="4"/><nd ref="1"/></way>
+  <relation id="50"><member type="way" ref="10" role="outer"/><member type="way" ref="99" role="inner"/>
+    <tag k="type" v="multipolygon"/><tag k="building" v="yes"/></relation>
+  <way id="12"><nd ref="1"/><tag k="building" v="yes"/></way>
+  <way id="30"><nd ref="1"/><nd ref="3"/><tag k="highway" v="primary"/></way>
+</osm>)";
+  map_io::MapLoadParams p;
+  p.file = writeTemp("relations.osm", osm);
+  p.origin_latitude = kFixtureLat;
+  p.origin_longitude = kFixtureLon;
+  map_io::MapLoadReport r;
+  const core::VectorMap m = map_io::loadVectorMap(p, &r);
+  EXPECT_TRUE(m.buildings.empty());
+  EXPECT_EQ(m.road_lines.size(), 1u);
+  EXPECT_EQ(r.skipped_incomplete_relations, 1u);
+  EXPECT_EQ(r.skipped_missing_nodes, 1u);  // way 12 has a single node
+  EXPECT_EQ(r.skipped_geometries, 2u);
+  bool named = false;
+  for (const auto& msg : r.messages) named = named || msg.find("relation/50") != std::string::npos;
+  EXPECT_TRUE(named);
+  std::filesystem::remove(p.file);
+}
+
 TEST(MapLoader, ProjectionMatchesGeographicLibToMillimetres)
 {
   const core::VectorMap m = map_io::loadVectorMap(fixtureParams("blocks.osm"));

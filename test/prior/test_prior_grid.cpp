@@ -200,6 +200,26 @@ TEST(BufferRoadLine, RectanglesAndDiscs)
   EXPECT_TRUE(out.empty());
 }
 
+TEST(PriorGrid, RoadJoinsAreRoundAndCourtyardsKeepTheRoadBelow)
+{
+  VectorMap m;
+  RoadLine l;
+  l.points = { { 0, 0 }, { 10, 0 }, { 10, 10 } };
+  l.width = 4.0;
+  m.road_lines.push_back(l);
+  Building ring;  // a building around the road's corner, with the corner in its courtyard
+  ring.footprint.outer = rect(6, -6, 16, 4);
+  ring.footprint.holes.push_back(rect(7, -5, 15, 3));
+  m.buildings.push_back(ring);
+  PriorGrid grid;
+  grid.build(m, testGrid());
+  EXPECT_EQ(grid.labelAt({ 10.5, -0.5 }), PriorClass::kRoad);   // inside the join's disc (0.71 m from the vertex)
+  EXPECT_EQ(grid.labelAt({ 11.5, -1.5 }), PriorClass::kOther);  // 2.12 m from the vertex: outside the buffer
+  EXPECT_EQ(grid.labelAt({ 11.5, 1.5 }), PriorClass::kRoad);    // second segment, in the courtyard
+  EXPECT_EQ(grid.labelAt({ 6.5, 0.5 }), PriorClass::kBuilding); // the ring's wall over the road
+  EXPECT_EQ(grid.labelAt({ 7.5, 0.5 }), PriorClass::kRoad);     // courtyard over the road: still road
+}
+
 TEST(PriorGrid, BlocksGiveExactClassCounts)
 {
   PriorGrid grid;

@@ -1,6 +1,10 @@
 // PriorGridParams validation and the published window (cap on the message size).
 #include <gtest/gtest.h>
 
+#include <set>
+
+#include <yaml-cpp/yaml.h>
+
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
 
@@ -11,7 +15,7 @@ using namespace map_aided_fusion;
 map_io::PriorGridParams valid()
 {
   map_io::PriorGridParams p;
-  p.map.file = "town.osm";
+  p.map.file = "town.osm";  // validate() does not open it
   return p;
 }
 
@@ -60,6 +64,27 @@ TEST(PriorGridParams, ValidationNamesTheParameter)
   p = valid();
   p.frame_id.clear();
   EXPECT_EQ(offending(p), "frame_id");
+}
+
+TEST(PriorGridParams, ConfigFileAndCodeNameTheSameKeys)
+{
+  const YAML::Node yaml = YAML::LoadFile(std::string(MAF_PACKAGE_DIR) + "/config/prior_grid.yaml");
+  std::set<std::string> in_yaml, in_code;
+  for (const auto& kv : yaml) in_yaml.insert(kv.first.as<std::string>());
+  map_io::PriorGridParams p;
+  map_io::forEachPriorGridParam(p, [&](const std::string& name, auto& value) {
+    in_code.insert(name);
+    if (const YAML::Node n = yaml[name]) value = n.as<std::remove_reference_t<decltype(value)>>();
+  });
+  EXPECT_EQ(in_yaml, in_code);
+  // The shipped configuration is valid once the launch file sets map_file, and holds the town's origin.
+  EXPECT_EQ(p.map.file, "");
+  p.map.file = "maps/town.osm";
+  EXPECT_NO_THROW(p.validate());
+  EXPECT_DOUBLE_EQ(p.map.origin_latitude, 49.4150);
+  EXPECT_DOUBLE_EQ(p.resolution, 0.5);
+  EXPECT_DOUBLE_EQ(p.max_published_cells, 4.0e6);
+  EXPECT_DOUBLE_EQ(p.map.road_class_widths.at("service"), 4.0);
 }
 
 TEST(PublishedWindow, WholeExtentByDefault)

@@ -25,7 +25,15 @@
  * Broken geometry (rings with fewer than 3 distinct vertices, non-finite coordinates, unclosed building ways,
  * ways whose nodes are missing from an extract, invalid polygons that cannot be repaired) is skipped and
  * counted in MapLoadReport (and VectorMap::skipped_geometries); invalid polygons are repaired with GEOS when
- * `repair_invalid` is set. Nothing is dropped silently.
+ * `repair_invalid` is set.
+ *
+ * OpenStreetMap specifics (GDAL's OSM driver): closed ways are read as lines and turned into polygons here, so
+ * that ways shortened by missing nodes are recognised (the driver reports them only through CPLDebug, which
+ * the loader captures) and skipped; relations the driver ignores because member ways are missing, and ways it
+ * drops for having fewer than 2 nodes, are counted by id (whatever their kind: the driver does not say).
+ * Known limits of the driver, not detectable here: a multipolygon relation whose rings do not close is
+ * dropped without a message, and an untagged member way with a missing node is shortened without one.
+ * Coordinates of OSM files have OSM's precision of 1e-7 degree (≤ 1.1 cm).
  */
 #pragma once
 
@@ -129,7 +137,9 @@ struct MapLoadReport
   std::size_t excluded_tunnels = 0;        ///< drivable roads left out because they are tunnels
   std::size_t skipped_geometries = 0;      ///< total skipped (the sum of the counts below)
   std::size_t skipped_unclosed = 0;        ///< building/road-area ways that are not closed rings
-  std::size_t skipped_missing_nodes = 0;   ///< ways with nodes missing from the extract
+  std::size_t skipped_missing_nodes = 0;   ///< ways with nodes missing from the extract (OSM: ways of any kind
+                                           ///< the reader dropped with < 2 nodes are included)
+  std::size_t skipped_incomplete_relations = 0;  ///< OSM relations (any kind) ignored: member ways missing
   std::size_t skipped_degenerate = 0;      ///< fewer than 3 distinct vertices (polygons) or 2 (lines), NaN
   std::size_t skipped_invalid = 0;         ///< invalid polygons not repaired
   std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance from the origin

@@ -38,6 +38,58 @@ struct PriorGridParams
 };
 
 /**
+ * @brief Calls `get(name, field)` for every parameter of @p p, by its name in config/prior_grid.yaml, so that
+ *        the ROS parameter server (PriorGridNodelet) and a YAML file (prior_grid_tool --config) read the same
+ *        keys. `get` leaves the field unchanged when the key is absent and throws core::ParameterError(name, …)
+ *        when its type is wrong. Field types: std::string, double, bool, std::vector<std::string>,
+ *        std::map<std::string, double> (road_class_widths: replaces the default table).
+ * @throws core::ParameterError for an unknown `source`.
+ */
+template <class Get>
+void forEachPriorGridParam(PriorGridParams& p, Get&& get)
+{
+  MapLoadParams& m = p.map;
+  get("map_file", m.file);
+  std::string source = toString(m.source);
+  get("source", source);
+  m.source = parseMapSourceKind(source);
+  get("origin_latitude", m.origin_latitude);
+  get("origin_longitude", m.origin_longitude);
+  get("origin_altitude", m.origin_altitude);
+  get("metric", m.metric);
+  get("max_origin_distance", m.max_origin_distance);
+  get("building_layer", m.building_layer);
+  get("road_layer", m.road_layer);
+  get("road_area_layer", m.road_area_layer);
+  get("building_attribute", m.building_attribute);
+  get("building_height_attribute", m.building_height_attribute);
+  get("building_levels_attribute", m.building_levels_attribute);
+  get("road_class_attribute", m.road_class_attribute);
+  get("road_width_attribute", m.road_width_attribute);
+  get("road_lanes_attribute", m.road_lanes_attribute);
+  get("road_area_attribute", m.road_area_attribute);
+  get("road_tunnel_attribute", m.road_tunnel_attribute);
+  get("exclude_tunnels", m.exclude_tunnels);
+  get("drivable_classes", m.drivable_classes);
+  get("lane_width", m.lane_width);
+  get("level_height", m.level_height);
+  get("default_road_width", m.default_road_width);
+  get("road_class_widths", m.road_class_widths);
+  get("repair_invalid", m.repair_invalid);
+  get("frame_id", p.frame_id);
+  get("resolution", p.resolution);
+  get("beta_building", p.beta.beta_building);
+  get("beta_road", p.beta.beta_road);
+  get("beta_other", p.beta.beta_other);
+  get("margin", p.margin);
+  get("publish_size", p.publish_size);
+  get("publish_centre_x", p.publish_centre_x);
+  get("publish_centre_y", p.publish_centre_y);
+  get("max_published_cells", p.max_published_cells);
+  get("publish_outlines", p.publish_outlines);
+}
+
+/**
  * @brief The window to publish: the map's @p extent, or the publish_size square around the publish centre,
  *        intersected with the extent and then capped at max_published_cells (a square around the publish
  *        centre, clipped to the extent). Aligned on @p extent's cells.
