@@ -1,0 +1,35 @@
+# Scenario simulator: ROS-free library (STL + yaml-cpp), rosbag writer, `simulate` tool, tests, benchmarks.
+find_package(yaml-cpp REQUIRED)
+
+add_library(map_aided_fusion_sim
+  src/sim/geometry.cpp
+  src/sim/scene.cpp
+  src/sim/motion.cpp
+  src/sim/lidar.cpp
+  src/sim/ground_truth.cpp
+  src/sim/scenario.cpp
+  src/sim/simulator.cpp
+)
+target_include_directories(map_aided_fusion_sim PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+target_link_libraries(map_aided_fusion_sim PUBLIC map_aided_fusion_core PRIVATE yaml-cpp)
+set_target_properties(map_aided_fusion_sim PROPERTIES POSITION_INDEPENDENT_CODE ON)
+
+install(TARGETS map_aided_fusion_sim
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+install(DIRECTORY scenarios DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})
+
+if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(test_simulator
+    test/sim/test_geometry.cpp
+    test/sim/test_motion.cpp
+    test/sim/test_simulator.cpp
+    test/test_main.cpp
+  )
+  target_link_libraries(test_simulator map_aided_fusion_sim)
+endif()
+
+if(TARGET bench_map_aided_fusion)
+  target_sources(bench_map_aided_fusion PRIVATE bench/bench_simulator.cpp)
+  target_link_libraries(bench_map_aided_fusion map_aided_fusion_sim)
+endif()
