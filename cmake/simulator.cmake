@@ -33,3 +33,25 @@ if(TARGET bench_map_aided_fusion)
   target_sources(bench_map_aided_fusion PRIVATE bench/bench_simulator.cpp)
   target_link_libraries(bench_map_aided_fusion map_aided_fusion_sim)
 endif()
+
+# ROS layer: message converters and the rosbag writer over the ROS-free simulator.
+add_library(map_aided_fusion_sim_bag src/ros/sim_bag.cpp)
+target_link_libraries(map_aided_fusion_sim_bag map_aided_fusion_sim map_aided_fusion_ros ${catkin_LIBRARIES})
+add_dependencies(map_aided_fusion_sim_bag ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+install(TARGETS map_aided_fusion_sim_bag
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+# `simulate` needs the map loader (map_aided_fusion_map_io, from cmake/prior_grid.cmake).
+if(TARGET map_aided_fusion_map_io)
+  add_executable(simulate src/tools/simulate.cpp)
+  target_link_libraries(simulate map_aided_fusion_sim_bag map_aided_fusion_map_io)
+  install(TARGETS simulate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+else()
+  message(STATUS "map_aided_fusion_map_io not found: the simulate tool is not built")
+endif()
+
+if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(test_sim_bag test/ros/test_sim_bag.cpp test/test_main.cpp)
+  target_link_libraries(test_sim_bag map_aided_fusion_sim_bag)
+endif()

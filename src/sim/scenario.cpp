@@ -213,6 +213,16 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
   sc.name = get<std::string>(root, "name", "", sc.name);
   const std::string map = get<std::string>(root, "map", "", "");
   if (!map.empty()) sc.map_file = (map.front() == '/' || base_dir.empty()) ? map : base_dir + "/" + map;
+  if (const YAML::Node origin = root["map_origin"])
+  {
+    const auto v = get<std::vector<double>>(root, "map_origin", "", {});
+    if (v.size() < 2 || v.size() > 3) throw ParameterError("map_origin", "must be [latitude, longitude(, altitude)]");
+    core::requireInRange("map_origin", v[0], -90.0, 90.0);
+    core::requireInRange("map_origin", v[1], -180.0, 180.0);
+    sc.map_origin_latitude = v[0];
+    sc.map_origin_longitude = v[1];
+    if (v.size() == 3) sc.map_origin_altitude = v[2];
+  }
   sc.duration = get<double>(root, "duration", "", sc.duration);
   sc.seed = get<std::uint64_t>(root, "seed", "", sc.seed);
   sc.default_building_height = get<double>(root, "default_building_height", "", sc.default_building_height);

@@ -219,6 +219,7 @@ TEST(SimScenario, ParsesYaml)
   const std::string text = R"(
 name: test
 map: ../maps/town.osm
+map_origin: [49.415, 2.823, 40]
 duration: 12.5
 seed: 99
 lidar: {preset: ibeo4, dropout_probability: 0.0}
@@ -239,6 +240,9 @@ objects:
   EXPECT_EQ(sc.name, "test");
   EXPECT_EQ(sc.map_file, "/pkg/scenarios/../maps/town.osm");
   EXPECT_DOUBLE_EQ(sc.duration, 12.5);
+  EXPECT_DOUBLE_EQ(sc.map_origin_latitude, 49.415);
+  EXPECT_DOUBLE_EQ(sc.map_origin_longitude, 2.823);
+  EXPECT_DOUBLE_EQ(sc.map_origin_altitude, 40.0);
   EXPECT_EQ(sc.seed, 99u);
   EXPECT_EQ(sc.lidar.preset, "ibeo4");
   EXPECT_EQ(sc.lidar.numBeams(), 4);
@@ -287,5 +291,6 @@ TEST(SimScenario, ErrorsNameTheKey)
   EXPECT_EQ(keyOf("[unclosed"), "yaml");
   EXPECT_EQ(keyOf(ego + "ground_truth: {resolution: 0}"), "ground_truth.resolution");
   EXPECT_EQ(keyOf(ego + "objects: [{kind: car, at: [0, 0]}, {id: 1, kind: car, at: [5, 0]}]"), "objects[id 1].id");
+  EXPECT_EQ(keyOf(ego + "map_origin: [91, 0]"), "map_origin");
   EXPECT_EQ(keyOf(ego), "no error");
 }

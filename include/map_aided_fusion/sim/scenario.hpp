@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,10 @@ struct Scenario
   std::string name = "scenario";
   std::string source;    ///< the YAML file it was loaded from, if any
   std::string map_file;  ///< absolute or relative to the working directory (resolved by loadScenario)
+  /// WGS84 origin of the map frame (degrees, degrees, metres); NaN: the map loader's default (data centre).
+  double map_origin_latitude = std::numeric_limits<double>::quiet_NaN();
+  double map_origin_longitude = std::numeric_limits<double>::quiet_NaN();
+  double map_origin_altitude = 0.0;
   double duration = 60.0;               ///< s
   std::uint64_t seed = 1;
   double default_building_height = 10.0;  ///< m, for map buildings without height
