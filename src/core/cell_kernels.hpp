@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 
 #include "map_aided_fusion/core/counter.hpp"
 #include "map_aided_fusion/core/discounting.hpp"
@@ -15,8 +16,10 @@
 #endif
 #if defined(__GNUC__)
 #define MAF_INLINE inline __attribute__((always_inline))
+#define MAF_LAMBDA_INLINE __attribute__((always_inline))
 #else
 #define MAF_INLINE inline
+#define MAF_LAMBDA_INLINE
 #endif
 // Whole-grid loops get an AVX2+FMA clone chosen at run time where the CPU has it.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(MAF_NO_TARGET_CLONES)
@@ -30,6 +33,80 @@ namespace core {
 namespace kernels {
 
 constexpr int kSubsets = FrameMG::kNumSubsets;
+
+/// Eight floats processed together (GCC/Clang vector extension: AVX registers in the AVX2 clone,
+/// pairs of SSE registers otherwise). The kernels below are templates on the lane type T, which is
+/// this vector in the grid loops, float for the remainder cells and double for the scalar reference.
+using Vec8 = float __attribute__((vector_size(32)));
+constexpr std::size_t kLanes = 8;
+
+/// @p v in every lane of T.
+template <typename T>
+MAF_INLINE T splat(float v)
+{
+  return T{} + v;
+}
+
+/// Per-lane mask ? a : b.
+template <typename M, typename T>
+MAF_INLINE T select(M mask, T a, T b)
+{
+  return mask ? a : b;
+}
+
+template <typename T>
+MAF_INLINE T load(const float* p);
+template <>
+MAF_INLINE float load<float>(const float* p)
+{
+  return *p;
+}
+template <>
+MAF_INLINE Vec8 load<Vec8>(const float* p)
+{
+  Vec8 v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+MAF_INLINE void store(float* p, float v) { *p = v; }
+MAF_INLINE void store(float* p, Vec8 v) { __builtin_memcpy(p, &v, sizeof v); }
+
+/// Sum of the lanes.
+MAF_INLINE float horizontalSum(float v) { return v; }
+MAF_INLINE float horizontalSum(Vec8 v)
+{
+  float s = 0.0f;
+  for (std::size_t l = 0; l < kLanes; ++l) s += v[l];
+  return s;
+}
+
+/// Cells per block of the whole-grid loops: one cache line of each plane.
+constexpr std::size_t kBlockCells = 16;
+/// How far ahead (in cells) the loops prefetch each plane: dozens of concurrent plane streams are more
+/// than the hardware prefetcher follows.
+constexpr std::size_t kPrefetchCells = 256;
+
+/// Prefetches, for writing, the line kPrefetchCells ahead of @p p in @p planes planes of @p stride floats.
+MAF_INLINE void prefetchPlanes(const float* p, std::size_t stride, int planes)
+{
+  for (int a = 0; a < planes; ++a) __builtin_prefetch(p + a * stride + kPrefetchCells, 1, 0);
+}
+
+/**
+ * Runs body(T{}, i) over cells [0, n): with T = Vec8 for whole groups of eight cells, then T = float for
+ * the rest. Every kBlockCells cells it prefetches @p planes planes of @p stride floats from @p base.
+ */
+template <class Body>
+MAF_INLINE void forEachCell(std::size_t n, const float* base, std::size_t stride, int planes, Body&& body)
+{
+  std::size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes)
+  {
+    if (base && i % kBlockCells == 0) prefetchPlanes(base + i, stride, planes);
+    body(Vec8{}, i);
+  }
+  for (; i < n; ++i) body(float{}, i);
+}
 
 /// The eight focal sets r(m_SG) ⊕ m_PG can have: intersections of {F, O, Ω} with {B, R, T, Ω}.
 enum ScanPriorIndex
@@ -67,13 +144,38 @@ constexpr std::array<int, 8> kUnion = makeUnionTable();
 
 constexpr bool isOccupiedSet(int a) { return a != 0 && isSubsetOf(static_cast<Subset>(a), FrameMG::kO); }
 
-/// m ← contextual discount of m (closed form, see ContextualDiscountWeights).
+/// ContextualDiscountWeights splatted to eight lanes, so that each product takes its weight from memory.
+struct ContextualDiscountWeights8
+{
+  Vec8 w[8][8];
+  explicit ContextualDiscountWeights8(const ContextualDiscountWeights<float>& f)
+  {
+    for (int o = 0; o < 8; ++o)
+      for (int s = 0; s < 8; ++s) w[o][s] = splat<Vec8>(f.w[o][s]);
+  }
+};
+
+/// The weights for lane type T: eight-lane weights for Vec8, plain ones otherwise.
 template <typename T>
-MAF_INLINE void contextualDiscount(T (&m)[kSubsets], const ContextualDiscountWeights<T>& w)
+MAF_INLINE const ContextualDiscountWeights8& weightsFor(const ContextualDiscountWeights<float>&,
+                                                         const ContextualDiscountWeights8& w8, Vec8)
+{
+  return w8;
+}
+template <typename T>
+MAF_INLINE const ContextualDiscountWeights<float>& weightsFor(const ContextualDiscountWeights<float>& w,
+                                                               const ContextualDiscountWeights8&, float)
+{
+  return w;
+}
+
+/// m ← contextual discount of m (closed form, see ContextualDiscountWeights).
+template <typename T, typename Weights>
+MAF_INLINE void contextualDiscount(T (&m)[kSubsets], const Weights& w)
 {
   T out[kSubsets];
   MAF_UNROLL
-  for (int a = 0; a < kSubsets; ++a) out[a] = T(0);
+  for (int a = 0; a < kSubsets; ++a) out[a] = T{};
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a)
   {
@@ -91,13 +193,14 @@ MAF_INLINE void contextualDiscount(T (&m)[kSubsets], const ContextualDiscountWei
  * Dempster conflict K.
  */
 template <typename T>
-MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T (&sp)[kNumScanPrior], T total_conflict_threshold)
+MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T (&sp)[kNumScanPrior], float total_conflict_threshold)
 {
-  const T pomega = T(1) - pb - pr - pt;
+  const T one = splat<T>(1.0f), zero = T{};
+  const T pomega = one - pb - pr - pt;
   const T k = pb * sf;
-  const T norm = T(1) - k;
-  const bool total = norm < total_conflict_threshold;
-  const T inv = total ? T(0) : T(1) / norm;
+  const T norm = one - k;
+  const auto total = norm < total_conflict_threshold;
+  const T inv = select(total, zero, one / norm);
   sp[kSpF] = sf * (pr + pt + pomega) * inv;
   sp[kSpC] = pb * (so + somega) * inv;
   sp[kSpSV] = pr * so * inv;
@@ -105,7 +208,7 @@ MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T (&sp)[kNumS
   sp[kSpCNSV] = pomega * so * inv;
   sp[kSpFSV] = pr * somega * inv;
   sp[kSpFNSV] = pt * somega * inv;
-  sp[kSpOmega] = total ? T(1) : pomega * somega * inv;
+  sp[kSpOmega] = select(total, one, pomega * somega * inv);
   return k;
 }
 
@@ -119,21 +222,68 @@ struct CellConflicts
 };
 
 /**
+ * g_out(A) = g_in(A) + g_in(A ∪ {b}) for every A ⊆ S ∖ {b}: turns the marginal of m on the subsets of S
+ * (g(A) = Σ_{X ∩ S = A} m(X)) into its marginal on the subsets of S ∖ {b}.
+ */
+template <int S, int B, typename T>
+MAF_INLINE void dropElement(const T (&in)[kSubsets], T (&out)[kSubsets])
+{
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a)
+    if (isSubsetOf(static_cast<Subset>(a), static_cast<Subset>(S & ~B))) out[a] = in[a] + in[a | B];
+}
+
+/// c[A] += w · g[A] for every A ⊆ S.
+template <int S, typename T>
+MAF_INLINE void accumulateOn(const T (&g)[kSubsets], T w, T (&c)[kSubsets])
+{
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a)
+    if (isSubsetOf(static_cast<Subset>(a), static_cast<Subset>(S))) c[a] += w * g[a];
+}
+
+/**
+ * c = m ∩ sp (unnormalised, c[∅] is the conflict) for sp in the sets of kScanPriorSets, through the
+ * marginals of m on each focal set S_k: (m ∩ sp)(A) = Σ_k sp_k · Σ_{X ∩ S_k = A} m(X). The marginals
+ * are built one dropped element at a time and shared between nested sets.
+ */
+template <typename T>
+MAF_INLINE void conjunctiveWithScanPrior(const T (&m)[kSubsets], const T (&sp)[kNumScanPrior], T (&c)[kSubsets])
+{
+  constexpr int F = FrameMG::kF, C = FrameMG::kC, N = FrameMG::kN, S = FrameMG::kS, V = FrameMG::kV;
+  constexpr int W = FrameMG::kOmega;
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a) c[a] = m[a] * sp[kSpOmega];
+  T fnsv[kSubsets], fsv[kSubsets], fv[kSubsets], f[kSubsets];
+  dropElement<W, C>(m, fnsv);
+  accumulateOn<F | N | S | V>(fnsv, sp[kSpFNSV], c);
+  dropElement<F | N | S | V, N>(fnsv, fsv);
+  accumulateOn<F | S | V>(fsv, sp[kSpFSV], c);
+  dropElement<F | S | V, S>(fsv, fv);
+  dropElement<F | V, V>(fv, f);
+  accumulateOn<F>(f, sp[kSpF], c);
+  T cnsv[kSubsets], nsv[kSubsets], sv[kSubsets], csv[kSubsets], cv[kSubsets], cc[kSubsets];
+  dropElement<W, F>(m, cnsv);
+  accumulateOn<C | N | S | V>(cnsv, sp[kSpCNSV], c);
+  dropElement<C | N | S | V, C>(cnsv, nsv);
+  accumulateOn<N | S | V>(nsv, sp[kSpNSV], c);
+  dropElement<N | S | V, N>(nsv, sv);
+  accumulateOn<S | V>(sv, sp[kSpSV], c);
+  dropElement<C | N | S | V, N>(cnsv, csv);
+  dropElement<C | S | V, S>(csv, cv);
+  dropElement<C | V, V>(cv, cc);
+  accumulateOn<C>(cc, sp[kSpC], c);
+}
+
+/**
  * m ← m ⊛ sp (sp in the sets of kScanPriorSets), the modified Yager rule; returns the conflicts.
  */
 template <typename T>
 MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumScanPrior])
 {
   T c[kSubsets];
-  MAF_UNROLL
-  for (int a = 0; a < kSubsets; ++a) c[a] = T(0);
-  MAF_UNROLL
-  for (int a = 0; a < kSubsets; ++a)
-  {
-    MAF_UNROLL
-    for (int k = 0; k < kNumScanPrior; ++k) c[a & kScanPriorSets[k]] += m[a] * sp[k];
-  }
-  T map_occupied = T(0);
+  conjunctiveWithScanPrior(m, sp, c);
+  T map_occupied = T{};
   MAF_UNROLL
   for (int a = 1; a < kSubsets; ++a)
     if (isOccupiedSet(a)) map_occupied += m[a];
@@ -144,7 +294,7 @@ MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumSc
   r.other = c[0] - r.free_occupied - r.occupied_free;
   c[FrameMG::kV] += r.free_occupied;
   c[FrameMG::kOmega] += c[0] - r.free_occupied;
-  c[0] = T(0);
+  c[0] = T{};
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a) m[a] = c[a];
   return r;
@@ -154,7 +304,7 @@ MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumSc
 template <typename T>
 MAF_INLINE T occupiedMass(const T (&m)[kSubsets])
 {
-  T s = T(0);
+  T s = T{};
   MAF_UNROLL
   for (int a = 1; a < kSubsets; ++a)
     if (isOccupiedSet(a)) s += m[a];
@@ -163,20 +313,22 @@ MAF_INLINE T occupiedMass(const T (&m)[kSubsets])
 
 /// Equation 3.
 template <typename T>
-MAF_INLINE T updateCounter(T zeta, T m_occupied, T conflict, T delta_inc, T delta_dec, T gamma_o, T gamma_conflict)
+MAF_INLINE T updateCounter(T zeta, T m_occupied, T conflict, float delta_inc, float delta_dec, float gamma_o,
+                           float gamma_conflict)
 {
+  const T one = splat<T>(1.0f), zero = T{};
   const T inc = zeta + delta_inc;
   const T dec = zeta - delta_dec;
-  const T up = inc < T(1) ? inc : T(1);
-  const T down = dec > T(0) ? dec : T(0);
-  return conflict > gamma_conflict ? down : (m_occupied >= gamma_o ? up : zeta);
+  const T up = select(inc < one, inc, one);
+  const T down = select(dec > zero, dec, zero);
+  return select(conflict > gamma_conflict, down, select(m_occupied >= gamma_o, up, zeta));
 }
 
 /// Equation 4, in place; @p literal selects SpecialisationMode::kLiteral.
 template <typename T>
 MAF_INLINE void specialise(T (&m)[kSubsets], T zeta, bool literal)
 {
-  T moved_empty = T(0);
+  T moved_empty = T{};
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a)
   {
@@ -197,12 +349,13 @@ MAF_INLINE void specialise(T (&m)[kSubsets], T zeta, bool literal)
   }
   if (literal)
   {
-    const T norm = T(1) - moved_empty;
-    const bool total = norm <= T(0);
-    const T inv = total ? T(0) : T(1) / norm;
+    const T one = splat<T>(1.0f), zero = T{};
+    const T norm = one - moved_empty;
+    const auto total = norm <= zero;
+    const T inv = select(total, zero, one / norm);
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) m[a] *= inv;
-    m[FrameMG::kOmega] += total ? T(1) : T(0);
+    m[FrameMG::kOmega] += select(total, one, zero);
   }
 }
 

@@ -1,5 +1,6 @@
 #include "map_aided_fusion/core/fusion.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "cell_kernels.hpp"
@@ -23,6 +24,64 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   return r;
 }
 
+namespace {
+
+/// Everything the fused loop reads, hoisted out of it.
+struct StepInputs
+{
+  float* base;
+  float* zeta;
+  std::size_t stride;
+  std::size_t cells;
+  const float* sf;
+  const float* so;
+  const float* sw;
+  const float* pb;
+  const float* pr;
+  const float* pt;
+  float delta_inc, delta_dec, gamma_occupied, gamma_conflict, threshold;
+  bool literal;
+};
+
+template <bool kHasPrior>
+MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights<float>& w, FusionStepStats& stats)
+{
+  float* __restrict base = in.base;
+  float* __restrict zeta = in.zeta;
+  const std::size_t stride = in.stride;
+  float sum_fo = 0.0f, sum_of = 0.0f, sum_other = 0.0f;
+  const kernels::ContextualDiscountWeights8 w8(w);
+  kernels::forEachCell(in.cells, base, stride, kSubsets + 1, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    using kernels::load;
+    T m[kSubsets];
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) m[a] = load<T>(base + a * stride + i);
+    T sp[kernels::kNumScanPrior];
+    const T zero{};
+    kernels::scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i),
+                           kHasPrior ? load<T>(in.pb + i) : zero, kHasPrior ? load<T>(in.pr + i) : zero,
+                           kHasPrior ? load<T>(in.pt + i) : zero, sp, in.threshold);
+    kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
+    const auto c = kernels::modifiedYager(m, sp);
+    const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m), c.free_occupied + c.occupied_free,
+                                       in.delta_inc, in.delta_dec, in.gamma_occupied, in.gamma_conflict);
+    kernels::store(zeta + i, z);
+    kernels::specialise(m, z, in.literal);
+    MAF_UNROLL
+    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
+    sum_fo += kernels::horizontalSum(c.free_occupied);
+    sum_of += kernels::horizontalSum(c.occupied_free);
+    sum_other += kernels::horizontalSum(c.other);
+  });
+  stats.sum_conflict_free_occupied = sum_fo;
+  stats.sum_conflict_occupied_free = sum_of;
+  stats.sum_conflict_other = sum_other;
+  stats.num_cells = in.cells;
+}
+
+}  // namespace
+
 MAF_TARGET_CLONES
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
                 FusionStepStats* stats)
@@ -32,50 +91,29 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   if (prior && prior->geometry != map.geometry())
     throw std::invalid_argument("fusionStep: prior window and map grid differ");
   const ContextualDiscountWeights<float> w(params.discount);
-  const std::size_t n = map.numCells();
-  const std::size_t stride = map.stride();
-  float* __restrict base = map.plane(0);
-  float* __restrict zeta = map.counter();
-  const float* __restrict sf = scan.plane(FrameSG::kF);
-  const float* __restrict so = scan.plane(FrameSG::kO);
-  const float* __restrict sw = scan.plane(FrameSG::kOmega);
-  const float* __restrict pb = prior ? prior->building.data() : nullptr;
-  const float* __restrict pr = prior ? prior->road.data() : nullptr;
-  const float* __restrict pt = prior ? prior->other.data() : nullptr;
-  const float di = static_cast<float>(params.counter.delta_inc), dd = static_cast<float>(params.counter.delta_dec);
-  const float go = static_cast<float>(params.counter.gamma_occupied);
-  const float gc = static_cast<float>(params.counter.gamma_conflict);
-  const bool literal = params.counter.mode == SpecialisationMode::kLiteral;
-  const float threshold = static_cast<float>(kTotalConflictThreshold);
-  float sum_fo = 0.0f, sum_of = 0.0f, sum_other = 0.0f;
-#pragma omp simd reduction(+ : sum_fo, sum_of, sum_other)
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    float m[kSubsets];
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
-    float sp[kernels::kNumScanPrior];
-    kernels::scanWithPrior(sf[i], so[i], sw[i], pb ? pb[i] : 0.0f, pr ? pr[i] : 0.0f, pt ? pt[i] : 0.0f, sp,
-                           threshold);
-    kernels::contextualDiscount(m, w);
-    const auto c = kernels::modifiedYager(m, sp);
-    const float z = kernels::updateCounter(zeta[i], kernels::occupiedMass(m), c.free_occupied + c.occupied_free, di,
-                                           dd, go, gc);
-    zeta[i] = z;
-    kernels::specialise(m, z, literal);
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = m[a];
-    sum_fo += c.free_occupied;
-    sum_of += c.occupied_free;
-    sum_other += c.other;
-  }
-  if (stats)
-  {
-    stats->sum_conflict_free_occupied = sum_fo;
-    stats->sum_conflict_occupied_free = sum_of;
-    stats->sum_conflict_other = sum_other;
-    stats->num_cells = n;
-  }
+  StepInputs in;
+  in.base = map.plane(0);
+  in.zeta = map.counter();
+  in.stride = map.stride();
+  in.cells = map.numCells();
+  in.sf = scan.plane(FrameSG::kF);
+  in.so = scan.plane(FrameSG::kO);
+  in.sw = scan.plane(FrameSG::kOmega);
+  in.pb = prior ? prior->building.data() : nullptr;
+  in.pr = prior ? prior->road.data() : nullptr;
+  in.pt = prior ? prior->other.data() : nullptr;
+  in.delta_inc = static_cast<float>(params.counter.delta_inc);
+  in.delta_dec = static_cast<float>(params.counter.delta_dec);
+  in.gamma_occupied = static_cast<float>(params.counter.gamma_occupied);
+  in.gamma_conflict = static_cast<float>(params.counter.gamma_conflict);
+  in.threshold = static_cast<float>(kTotalConflictThreshold);
+  in.literal = params.counter.mode == SpecialisationMode::kLiteral;
+  FusionStepStats local;
+  if (prior)
+    fusionLoop<true>(in, w, local);
+  else
+    fusionLoop<false>(in, w, local);
+  if (stats) *stats = local;
 }
 
 }  // namespace core

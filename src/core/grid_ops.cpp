@@ -51,15 +51,16 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
   const float* __restrict pr = prior.road.data();
   const float* __restrict pt = prior.other.data();
   const float threshold = static_cast<float>(kTotalConflictThreshold);
-#pragma omp simd
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    float m[kSubsets];
+  kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    using kernels::load;
+    T m[kSubsets];
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
-    const float b = pb[i], r = pr[i], t = pt[i];
-    const float u = 1.0f - b - r - t;
-    float c[kSubsets];
+    for (int a = 0; a < kSubsets; ++a) m[a] = load<T>(base + a * stride + i);
+    const T b = load<T>(pb + i), r = load<T>(pr + i), t = load<T>(pt + i);
+    const T one = kernels::splat<T>(1.0f), zero{};
+    const T u = one - b - r - t;
+    T c[kSubsets];
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) c[a] = u * m[a];
     MAF_UNROLL
@@ -69,16 +70,16 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
       c[a & FrameMG::kRoad] += r * m[a];
       c[a & FrameMG::kOther] += t * m[a];
     }
-    const float norm = 1.0f - c[0];
-    const bool total = norm < threshold;
-    const float inv = total ? 0.0f : 1.0f / norm;
-    c[0] = 0.0f;
+    const T norm = one - c[0];
+    const auto total = norm < threshold;
+    const T inv = kernels::select(total, zero, one / norm);
+    c[0] = zero;
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) c[a] *= inv;
-    c[FrameMG::kOmega] += total ? 1.0f : 0.0f;
+    c[FrameMG::kOmega] += kernels::select(total, one, zero);
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = c[a];
-  }
+    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, c[a]);
+  });
 }
 
 MAF_TARGET_CLONES
@@ -88,16 +89,16 @@ void contextualDiscountGrid(MapMassGrid& grid, const ContextualRates& rates)
   const std::size_t n = grid.numCells();
   const std::size_t stride = grid.stride();
   float* __restrict base = grid.plane(0);
-#pragma omp simd
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    float m[kSubsets];
+  const kernels::ContextualDiscountWeights8 w8(w);
+  kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    T m[kSubsets];
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
-    kernels::contextualDiscount(m, w);
+    for (int a = 0; a < kSubsets; ++a) m[a] = kernels::load<T>(base + a * stride + i);
+    kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = m[a];
-  }
+    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
+  });
 }
 
 MAF_TARGET_CLONES
@@ -112,16 +113,16 @@ void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassG
   const float* sb = scan.plane(0);
   float* ob = out.plane(0);
   if (&out != &map) std::copy(map.counter(), map.counter() + n, out.counter());
-#pragma omp simd
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    float m1[kSubsets], m2[kSubsets], c[kSubsets];
+  kernels::forEachCell(n, nullptr, stride, 0, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    using kernels::load;
+    T m1[kSubsets], m2[kSubsets], c[kSubsets];
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a)
     {
-      m1[a] = mb[a * stride + i];
-      m2[a] = sb[a * stride + i];
-      c[a] = 0.0f;
+      m1[a] = load<T>(mb + a * stride + i);
+      m2[a] = load<T>(sb + a * stride + i);
+      c[a] = T{};
     }
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a)
@@ -129,16 +130,16 @@ void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassG
       MAF_UNROLL
       for (int b = 0; b < kSubsets; ++b) c[a & b] += m1[a] * m2[b];
     }
-    const float fo = m1[FrameMG::kF] * kernels::occupiedMass(m2);
-    const float of = kernels::occupiedMass(m1) * m2[FrameMG::kF];
+    const T fo = m1[FrameMG::kF] * kernels::occupiedMass(m2);
+    const T of = kernels::occupiedMass(m1) * m2[FrameMG::kF];
     c[FrameMG::kV] += fo;
     c[FrameMG::kOmega] += c[0] - fo;
-    c[0] = 0.0f;
+    c[0] = T{};
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) ob[a * stride + i] = c[a];
-    if (conflict_free_occupied) conflict_free_occupied[i] = fo;
-    if (conflict_occupied_free) conflict_occupied_free[i] = of;
-  }
+    for (int a = 0; a < kSubsets; ++a) kernels::store(ob + a * stride + i, c[a]);
+    if (conflict_free_occupied) kernels::store(conflict_free_occupied + i, fo);
+    if (conflict_occupied_free) kernels::store(conflict_occupied_free + i, of);
+  });
 }
 
 MAF_TARGET_CLONES
@@ -153,19 +154,19 @@ void updateCounterAndSpecialiseGrid(MapMassGrid& grid, const float* conflict_fre
   const float di = static_cast<float>(params.delta_inc), dd = static_cast<float>(params.delta_dec);
   const float go = static_cast<float>(params.gamma_occupied), gc = static_cast<float>(params.gamma_conflict);
   const bool literal = params.mode == SpecialisationMode::kLiteral;
-#pragma omp simd
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    float m[kSubsets];
+  kernels::forEachCell(n, base, stride, kSubsets + 1, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    using kernels::load;
+    T m[kSubsets];
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = base[a * stride + i];
-    const float conflict = conflict_free_occupied[i] + conflict_occupied_free[i];
-    const float z = kernels::updateCounter(zeta[i], kernels::occupiedMass(m), conflict, di, dd, go, gc);
-    zeta[i] = z;
+    for (int a = 0; a < kSubsets; ++a) m[a] = load<T>(base + a * stride + i);
+    const T conflict = load<T>(conflict_free_occupied + i) + load<T>(conflict_occupied_free + i);
+    const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m), conflict, di, dd, go, gc);
+    kernels::store(zeta + i, z);
     kernels::specialise(m, z, literal);
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) base[a * stride + i] = m[a];
-  }
+    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
+  });
 }
 
 MAF_TARGET_CLONES
@@ -180,28 +181,28 @@ void pignisticGrid(const MapMassGrid& grid, PignisticPlanes& out)
   float* __restrict p2 = out.p[2].data();
   float* __restrict p3 = out.p[3].data();
   float* __restrict p4 = out.p[4].data();
-#pragma omp simd
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    float acc[FrameMG::kSize] = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
+  kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    T acc[FrameMG::kSize] = {};
     MAF_UNROLL
     for (int a = 1; a < kSubsets; ++a)
     {
-      const float share = base[a * stride + i] * (1.0f / cardinality(static_cast<Subset>(a)));
+      const T share = kernels::load<T>(base + a * stride + i) * (1.0f / cardinality(static_cast<Subset>(a)));
       MAF_UNROLL
       for (int e = 0; e < FrameMG::kSize; ++e)
         if (a & (1 << e)) acc[e] += share;
     }
-    const float norm = 1.0f - base[i];
-    const bool none = norm <= 0.0f;
-    const float inv = none ? 0.0f : 1.0f / norm;
-    const float uniform = none ? 1.0f / FrameMG::kSize : 0.0f;
-    p0[i] = acc[0] * inv + uniform;
-    p1[i] = acc[1] * inv + uniform;
-    p2[i] = acc[2] * inv + uniform;
-    p3[i] = acc[3] * inv + uniform;
-    p4[i] = acc[4] * inv + uniform;
-  }
+    const T one = kernels::splat<T>(1.0f), zero{};
+    const T norm = one - kernels::load<T>(base + i);
+    const auto none = norm <= zero;
+    const T inv = kernels::select(none, zero, one / norm);
+    const T uniform = kernels::select(none, kernels::splat<T>(1.0f / FrameMG::kSize), zero);
+    kernels::store(p0 + i, acc[0] * inv + uniform);
+    kernels::store(p1 + i, acc[1] * inv + uniform);
+    kernels::store(p2 + i, acc[2] * inv + uniform);
+    kernels::store(p3 + i, acc[3] * inv + uniform);
+    kernels::store(p4 + i, acc[4] * inv + uniform);
+  });
 }
 
 }  // namespace core

@@ -15,8 +15,11 @@
 namespace map_aided_fusion {
 namespace core {
 
-/// Floats per plane are rounded up to a multiple of this (64 bytes), so every plane is aligned.
+/// Planes start on a cache line: their stride is a multiple of this many floats (64 bytes).
 constexpr std::size_t kPlaneAlignmentFloats = 16;
+/// Plane strides are a multiple of a page plus one cache line, so that the planes of one cell never
+/// share a cache set (a page-multiple stride makes 33 streams fight over the same sets).
+constexpr std::size_t kPlanePageFloats = 1024;
 
 /**
  * @brief A grid of mass functions on @p Frame. Plane a (a = subset mask) holds m(a) for every cell,
@@ -37,7 +40,7 @@ public:
   {
     geometry_ = geometry;
     const std::size_t n = geometry.numCells();
-    stride_ = (n + kPlaneAlignmentFloats - 1) / kPlaneAlignmentFloats * kPlaneAlignmentFloats;
+    stride_ = (n + kPlanePageFloats - 1) / kPlanePageFloats * kPlanePageFloats + kPlaneAlignmentFloats;
     data_.assign(stride_ * (kNumPlanes + 1), 0.0f);
     fillVacuous();
   }

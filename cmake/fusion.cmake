@@ -1,0 +1,17 @@
+# Fusion component: FusionNodelet, fusion_node, their tests and benchmarks.
+add_library(map_aided_fusion_fusion_nodelet
+  src/ros/fusion_worker.cpp
+  src/ros/param_loading.cpp
+  src/ros/visualization.cpp
+  src/nodelets/fusion_nodelet.cpp
+)
+target_link_libraries(map_aided_fusion_fusion_nodelet map_aided_fusion_ros ${catkin_LIBRARIES})
+add_dependencies(map_aided_fusion_fusion_nodelet ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg)
+
+add_executable(fusion_node src/nodes/fusion_node.cpp)
+target_link_libraries(fusion_node map_aided_fusion_fusion_nodelet)
+
+install(TARGETS map_aided_fusion_fusion_nodelet fusion_node
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

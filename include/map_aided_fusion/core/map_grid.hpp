@@ -1,0 +1,153 @@
+/**
+ * @file map_grid.hpp
+ * @brief The MapGrid: a rolling window of mass functions on Ω_MG in the `map` frame that follows the
+ *        vehicle and fuses one ScanGrid per scan with the PriorGrid (sections 2.3–2.5 of the paper).
+ */
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "map_aided_fusion/core/cell_class.hpp"
+#include "map_aided_fusion/core/fusion.hpp"
+#include "map_aided_fusion/core/grid_ops.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+/// A planar pose: position (metres) and heading (radians, counter-clockwise from +x), REP-103.
+struct Pose2
+{
+  double x = 0.0;
+  double y = 0.0;
+  double yaw = 0.0;
+};
+
+/// Parameters of the MapGrid (config/fusion.yaml).
+struct MapGridParams
+{
+  double size_x = 100.0;     ///< window length along x, metres (> 0)
+  double size_y = 100.0;     ///< window length along y, metres (> 0)
+  double resolution = 0.5;   ///< cell side, metres (> 0); the paper's 0.5 m
+  FusionParams fusion;       ///< α, δ, γ and the specialisation mode
+  /**
+   * When true the rates α are per second: a scan Δt after the previous one is discounted with
+   * 1 − (1 − α)^Δt, so that a varying scan rate or a dropped scan forgets the right amount.
+   * When false (the paper) they are per scan.
+   */
+  bool rates_per_second = false;
+  double decision_threshold = 0.4;  ///< BetP a class needs to be a cell's decision, in [0, 1]
+  int min_object_cells = 3;         ///< smaller connected S or V regions are noise (cells, ≥ 1)
+  /// @throws ParameterError naming the first parameter out of range.
+  void validate() const;
+};
+
+/// Wall time of each stage of MapGrid::update(), seconds.
+struct StageTimes
+{
+  double shift = 0.0;
+  double project_scan = 0.0;
+  double prior_window = 0.0;
+  double fusion = 0.0;
+  double total() const { return shift + project_scan + prior_window + fusion; }
+};
+
+/// An object made of a connected region of moving or stopped cells.
+struct GridObject
+{
+  CellClass cell_class = CellClass::kMoving;  ///< kMoving or kStopped
+  Point2 centroid;                            ///< metres, map frame
+  double yaw = 0.0;                           ///< orientation of the major axis, radians
+  double length = 0.0;                        ///< extent along the major axis, metres (cells included)
+  double width = 0.0;                         ///< extent along the minor axis, metres
+  int cells = 0;                              ///< number of cells
+  double mean_betp = 0.0;                     ///< mean BetP of the object's class over its cells
+};
+
+/**
+ * @brief Maps a ScanGrid given in the vehicle frame into the cells of @p window (map frame).
+ *
+ * Sampling: every window cell takes the scan cell under its centre (nearest neighbour, through the inverse
+ * pose), so mass functions are copied, never blended; then every scan cell that carries occupied mass
+ * overwrites the window cell under its own centre when it is more occupied. With the same resolution and
+ * no rotation this is an exact one-to-one copy; under rotation no occupied scan cell is lost (a thin pole
+ * never vanishes between cells). Window cells outside the scan are vacuous.
+ */
+void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const GridGeometry& window,
+                 ScanMassGrid& out);
+
+/**
+ * @brief The prior masses of @p window, sampled at each window cell's centre from @p prior (nearest
+ *        neighbour; an exact copy when the lattices are aligned). Cells outside @p prior are vacuous.
+ */
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out);
+
+/**
+ * @brief Decision per cell: the class of largest BetP when it reaches @p threshold, kUnknown otherwise or
+ *        where the cell is vacuous (m(Ω) ≥ 1 − 1e-3).
+ */
+void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out);
+
+/// Connected regions (8-connectivity) of kMoving or kStopped decisions with at least @p min_cells cells.
+std::vector<GridObject> extractObjects(const GridGeometry& geometry, const std::vector<std::int8_t>& decision,
+                                       const PignisticPlanes& betp, int min_cells);
+
+/**
+ * @brief The rolling-window MapGrid and the per-scan pipeline of the paper.
+ *
+ * The window follows the vehicle by whole-cell shifts: stored evidence is moved, never resampled; cells
+ * entering the window are vacuous with ζ = 0; cells leaving it are dropped. Window origins are multiples
+ * of the resolution, so a prior on the same lattice is copied exactly.
+ */
+class MapGrid
+{
+public:
+  /// @throws ParameterError when @p params are out of range.
+  explicit MapGrid(const MapGridParams& params);
+
+  /// Replaces the parameters between scans (the window is reallocated if its size or resolution changed).
+  void setParams(const MapGridParams& params);
+  const MapGridParams& params() const { return params_; }
+
+  /// Forgets everything: vacuous cells, ζ = 0, no previous scan.
+  void reset();
+
+  /**
+   * @brief One scan: recentre the window on the vehicle, map the scan into it, refine, combine with the
+   *        prior (Dempster), discount the previous MapGrid, fuse (modified Yager), update ζ, specialise.
+   * @param scan   ScanGrid in the vehicle frame
+   * @param pose   vehicle pose in the map frame at the scan's time
+   * @param stamp  scan time, seconds (used for rates_per_second)
+   * @param prior  the whole PriorGrid in the map frame, or nullptr for a vacuous prior
+   */
+  FusionStepStats update(const ScanMassGrid& scan, const Pose2& pose, double stamp, const PriorWindow* prior,
+                         StageTimes* times = nullptr);
+
+  /**
+   * @brief Moves the window by whole cells: the cell at (x, y) moves to (x − dx, y − dy) and the origin by
+   *        (dx, dy) cells. Masses and ζ are moved bit-exactly.
+   */
+  void shift(int dx, int dy);
+
+  /// Centres the window on @p p by a whole-cell shift (no-op when already centred).
+  void recentre(Point2 p);
+
+  const MapMassGrid& masses() const { return grid_; }
+  MapMassGrid& masses() { return grid_; }
+  const GridGeometry& geometry() const { return grid_.geometry(); }
+  /// The scan of the last update, in window cells.
+  const ScanMassGrid& lastScanInWindow() const { return scan_window_; }
+  /// Number of scans fused since the last reset.
+  std::size_t scans() const { return scans_; }
+
+private:
+  MapGridParams params_;
+  MapMassGrid grid_;
+  ScanMassGrid scan_window_;
+  PriorWindow prior_window_;
+  double last_stamp_ = 0.0;
+  std::size_t scans_ = 0;
+};
+
+}  // namespace core
+}  // namespace map_aided_fusion

@@ -1,0 +1,147 @@
+/**
+ * @file map_loader.hpp
+ * @brief Reads a geographic map (OpenStreetMap XML/PBF, GeoJSON, Shapefile, GeoPackage) with GDAL/OGR and
+ *        projects it with GeographicLib into the local metric `map` frame (ENU, REP-103/105) as a
+ *        core::VectorMap: buildings, road areas and road centre lines with their widths.
+ *
+ * ROS-free: GDAL, GeographicLib and map_aided_fusion_core only (library `map_aided_fusion_map_io`).
+ *
+ * What is a building, a road area, a road centre line:
+ *  - building: a polygon (closed OSM way or multipolygon relation) whose `building_attribute` is set and not
+ *    "no"; or any polygon of `building_layer` when that parameter is set. Holes (courtyards) are kept.
+ *  - road area: a polygon whose `road_area_attribute` (`area:highway`) is set, or a polygon with a drivable
+ *    `road_class_attribute` and `area=yes`; or any polygon of `road_area_layer`.
+ *  - road centre line: a line whose `road_class_attribute` (`highway`) is one of `drivable_classes`
+ *    (or any line of `road_layer`, filtered by class when the class attribute exists and the list is not
+ *    {"*"}). Its width: `road_width_attribute` when > 0, else `road_lanes_attribute` × lane_width, else
+ *    `road_class_widths[class]`, else default_road_width.
+ *  Road areas and centre lines are both kept: the road surface is their union (an `area:highway` polygon and
+ *  the centre line inside it do not conflict). Where buildings and roads overlap, the PriorGrid lets the
+ *  building win.
+ *
+ * Broken geometry (rings with fewer than 3 distinct vertices, non-finite coordinates, unclosed building ways,
+ * ways whose nodes are missing from an extract, invalid polygons that cannot be repaired) is skipped and
+ * counted in MapLoadReport (and VectorMap::skipped_geometries); invalid polygons are repaired with GEOS when
+ * `repair_invalid` is set. Nothing is dropped silently.
+ */
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "map_aided_fusion/core/vector_map.hpp"
+
+namespace map_aided_fusion {
+namespace map_io {
+
+/// File format of a map source.
+enum class MapSourceKind
+{
+  kAuto,        ///< from the file name's extension (.osm, .pbf, .geojson/.json, .shp, .gpkg), else GDAL guesses
+  kOsm,         ///< OpenStreetMap XML (.osm) or PBF (.osm.pbf)
+  kGeoJson,     ///< GeoJSON
+  kShapefile,   ///< ESRI Shapefile (a .shp file or a folder of them)
+  kGeoPackage,  ///< OGC GeoPackage (e.g. IGN BD TOPO)
+};
+
+/// "auto", "osm", "geojson", "shapefile", "gpkg" → MapSourceKind. @throws core::ParameterError("source", …).
+MapSourceKind parseMapSourceKind(const std::string& name);
+/// MapSourceKind → its name as accepted by parseMapSourceKind().
+std::string toString(MapSourceKind kind);
+
+/// Default drivable OSM `highway` classes (motorway … residential, service, living_street and the links).
+std::vector<std::string> defaultDrivableClasses();
+/// Default full road width per OSM `highway` class, metres.
+std::map<std::string, double> defaultRoadClassWidths();
+
+/// Everything loadVectorMap() needs. Defaults suit OpenStreetMap; see config/prior_grid.yaml.
+struct MapLoadParams
+{
+  std::string file;                             ///< path of the map file
+  MapSourceKind source = MapSourceKind::kAuto;  ///< file format
+
+  /// Origin of the `map` frame (WGS84). NaN latitude/longitude: the centre of the data's bounding box.
+  double origin_latitude = std::numeric_limits<double>::quiet_NaN();   ///< degrees, [-90, 90]
+  double origin_longitude = std::numeric_limits<double>::quiet_NaN();  ///< degrees, [-180, 180]
+  double origin_altitude = 0.0;                                        ///< metres above the ellipsoid
+  /// True: coordinates are already metric in the `map` frame (HD maps in local coordinates); no projection.
+  bool metric = false;
+  /// Data whose nearest vertex is farther than this from the origin is an error; features entirely farther
+  /// are dropped and counted (metres, > 0).
+  double max_origin_distance = 50000.0;
+
+  // Layers (GeoJSON/Shapefile/GeoPackage). Empty: decide from the attributes below, on every layer.
+  std::string building_layer;   ///< e.g. "BATIMENT" (IGN BD TOPO)
+  std::string road_layer;       ///< e.g. "TRONCON_DE_ROUTE" (IGN BD TOPO)
+  std::string road_area_layer;  ///< layer of road surfaces as polygons
+
+  // Attributes (OSM keys for OSM sources).
+  std::string building_attribute = "building";                ///< set and not "no": a building
+  std::string building_height_attribute = "height";           ///< metres (IGN: "HAUTEUR")
+  std::string building_levels_attribute = "building:levels";  ///< storeys (IGN: "NOMBRE_D_ETAGES")
+  std::string road_class_attribute = "highway";               ///< road class (IGN: "NATURE")
+  std::string road_width_attribute = "width";                 ///< metres (IGN: "LARGEUR")
+  std::string road_lanes_attribute = "lanes";                 ///< lanes (IGN: "NB_VOIES")
+  std::string road_area_attribute = "area:highway";           ///< set: the polygon is a road surface
+
+  /// Road classes that are road surface; {"*"} accepts every class.
+  std::vector<std::string> drivable_classes = defaultDrivableClasses();
+  double lane_width = 3.5;          ///< metres per lane (> 0)
+  double level_height = 3.0;        ///< metres per storey (> 0)
+  double default_road_width = 6.0;  ///< metres, for a class missing from road_class_widths (> 0)
+  std::map<std::string, double> road_class_widths = defaultRoadClassWidths();  ///< metres (> 0)
+  /// Repair invalid polygons (self-intersections…) with GEOS (OGRGeometry::MakeValid); false: keep as read.
+  bool repair_invalid = true;
+
+  /// @throws core::ParameterError naming the offending parameter.
+  void validate() const;
+};
+
+/// A map that cannot be loaded: the message names the file and the cause.
+class MapLoadError : public std::runtime_error
+{
+public:
+  explicit MapLoadError(const std::string& what) : std::runtime_error(what) {}
+};
+
+/// What loadVectorMap() read, kept and skipped.
+struct MapLoadReport
+{
+  std::string file;                        ///< the file read
+  std::string driver;                      ///< GDAL driver used
+  double origin_latitude = 0.0;            ///< origin actually used (degrees)
+  double origin_longitude = 0.0;           ///< origin actually used (degrees)
+  double origin_altitude = 0.0;            ///< origin actually used (metres)
+  std::size_t features_read = 0;           ///< features examined (all layers)
+  std::size_t buildings = 0;               ///< building polygons kept (a multipolygon counts per part)
+  std::size_t road_areas = 0;              ///< road area polygons kept
+  std::size_t road_lines = 0;              ///< road centre lines kept
+  std::size_t repaired_geometries = 0;     ///< invalid polygons repaired
+  std::size_t skipped_geometries = 0;      ///< total skipped (the sum of the counts below)
+  std::size_t skipped_unclosed = 0;        ///< building/road-area ways that are not closed rings
+  std::size_t skipped_missing_nodes = 0;   ///< ways with nodes missing from the extract
+  std::size_t skipped_degenerate = 0;      ///< fewer than 3 distinct vertices (polygons) or 2 (lines), NaN
+  std::size_t skipped_invalid = 0;         ///< invalid polygons not repaired
+  std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance from the origin
+  std::vector<std::string> messages;       ///< the first few skip reasons, with feature ids
+};
+
+/**
+ * @brief Reads, filters and projects a map into the local `map` frame.
+ * @param params validated parameters (validate() is called again here)
+ * @param report optional: counts of what was kept and skipped
+ * @throws MapLoadError naming the file and the cause: missing/unreadable file, unknown format, no usable
+ *         feature, origin farther than max_origin_distance from the data.
+ * @throws core::ParameterError on invalid parameters.
+ */
+core::VectorMap loadVectorMap(const MapLoadParams& params, MapLoadReport* report = nullptr);
+
+/// One-paragraph human-readable summary of a report (for logs and the command-line tool).
+std::string summary(const MapLoadReport& report);
+
+}  // namespace map_io
+}  // namespace map_aided_fusion

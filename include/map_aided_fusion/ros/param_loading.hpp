@@ -1,0 +1,34 @@
+/**
+ * @file param_loading.hpp
+ * @brief Reading typed parameter structs from the ROS parameter server (values from the config folder's YAML files).
+ */
+#pragma once
+
+#include <string>
+
+#include <ros/node_handle.h>
+
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/parameters.hpp"
+
+namespace map_aided_fusion {
+
+/// @p value keeps its default when @p name is not set; a value of the wrong type is a ParameterError.
+template <typename T>
+void readParam(const ros::NodeHandle& nh, const std::string& name, T& value)
+{
+  if (!nh.hasParam(name)) return;
+  if (!nh.getParam(name, value))
+    throw core::ParameterError(name, "has the wrong type (" + nh.resolveName(name) + ")");
+}
+
+/// double parameters may be written as integers in YAML.
+void readParam(const ros::NodeHandle& nh, const std::string& name, double& value);
+
+/**
+ * @brief The MapGrid parameters from @p nh (the fusion nodelet's private namespace; see config/fusion.yaml).
+ * @throws core::ParameterError naming the parameter that is missing its type or out of range.
+ */
+core::MapGridParams loadMapGridParams(const ros::NodeHandle& nh);
+
+}  // namespace map_aided_fusion

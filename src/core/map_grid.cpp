@@ -1,0 +1,327 @@
+#include "map_aided_fusion/core/map_grid.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "map_aided_fusion/core/parameters.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+namespace {
+
+/// Largest window side, in cells (a 8192 × 8192 MapGrid already needs 8.6 GB).
+constexpr int kMaxWindowCells = 8192;
+/// m(Ω) at or above 1 − this is a vacuous cell.
+constexpr float kVacuousTolerance = 1e-3f;
+
+double secondsSince(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The window origin (multiple of the resolution) that centres a window of @p g's size on @p p.
+Point2 snappedOrigin(const GridGeometry& g, Point2 p)
+{
+  return Point2{ std::round((p.x - 0.5 * g.sizeX()) / g.resolution) * g.resolution,
+                 std::round((p.y - 0.5 * g.sizeY()) / g.resolution) * g.resolution };
+}
+
+template <class Frame>
+void copyCell(const MassGrid<Frame>& from, std::size_t i, MassGrid<Frame>& to, std::size_t j)
+{
+  for (int a = 0; a < Frame::kNumSubsets; ++a) to.plane(static_cast<Subset>(a))[j] = from.plane(static_cast<Subset>(a))[i];
+}
+
+}  // namespace
+
+void MapGridParams::validate() const
+{
+  requirePositive("resolution", resolution);
+  requirePositive("size_x", size_x);
+  requirePositive("size_y", size_y);
+  if (size_x / resolution > kMaxWindowCells)
+    throw ParameterError("size_x", "more than " + std::to_string(kMaxWindowCells) + " cells at this resolution");
+  if (size_y / resolution > kMaxWindowCells)
+    throw ParameterError("size_y", "more than " + std::to_string(kMaxWindowCells) + " cells at this resolution");
+  if (std::lround(size_x / resolution) < 1) throw ParameterError("size_x", "smaller than one cell");
+  if (std::lround(size_y / resolution) < 1) throw ParameterError("size_y", "smaller than one cell");
+  requireUnit("decision_threshold", decision_threshold);
+  if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
+  fusion.validate();
+}
+
+void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)
+{
+  if (out.geometry() != window)
+    out.reset(window);
+  else
+    out.fillVacuous();
+  const GridGeometry& sg = scan.geometry();
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  // Inverse mapping: window cell centre → vehicle frame → scan cell.
+  for (int y = 0; y < window.height; ++y)
+  {
+    const Point2 first = window.cellCentre(CellIndex{ 0, y });
+    const double dx = first.x - pose.x, dy = first.y - pose.y;
+    double vx = c * dx + s * dy, vy = -s * dx + c * dy;
+    const double step_x = c * window.resolution, step_y = -s * window.resolution;
+    for (int x = 0; x < window.width; ++x, vx += step_x, vy += step_y)
+    {
+      CellIndex sc;
+      if (sg.worldToCell(Point2{ vx, vy }, sc)) copyCell(scan, sg.index(sc), out, window.index(x, y));
+    }
+  }
+  // Forward pass: every occupied scan cell marks the window cell under its centre.
+  const float* so = scan.plane(FrameSG::kO);
+  float* wo = out.plane(FrameSG::kO);
+  for (std::size_t i = 0; i < scan.numCells(); ++i)
+  {
+    if (so[i] <= 0.0f) continue;
+    const Point2 v = sg.cellCentre(sg.cellOf(i));
+    CellIndex wc;
+    if (!window.worldToCell(Point2{ pose.x + c * v.x - s * v.y, pose.y + s * v.x + c * v.y }, wc)) continue;
+    const std::size_t j = window.index(wc);
+    if (so[i] > wo[j]) copyCell(scan, i, out, j);
+  }
+}
+
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out)
+{
+  if (out.geometry != window || out.building.size() != window.numCells())
+    out.reset(window);
+  std::vector<int> column(static_cast<std::size_t>(window.width));
+  for (int x = 0; x < window.width; ++x)
+  {
+    const double wx = window.cellCentre(CellIndex{ x, 0 }).x;
+    const double fx = std::floor((wx - prior.geometry.origin_x) / prior.geometry.resolution);
+    column[static_cast<std::size_t>(x)] = fx >= 0 && fx < prior.geometry.width ? static_cast<int>(fx) : -1;
+  }
+  for (int y = 0; y < window.height; ++y)
+  {
+    const double wy = window.cellCentre(CellIndex{ 0, y }).y;
+    const double fy = std::floor((wy - prior.geometry.origin_y) / prior.geometry.resolution);
+    const bool row_inside = fy >= 0 && fy < prior.geometry.height;
+    for (int x = 0; x < window.width; ++x)
+    {
+      const std::size_t j = window.index(x, y);
+      const int px = column[static_cast<std::size_t>(x)];
+      if (!row_inside || px < 0)
+      {
+        out.building[j] = out.road[j] = out.other[j] = 0.0f;
+        continue;
+      }
+      const std::size_t i = prior.geometry.index(px, static_cast<int>(fy));
+      out.building[j] = prior.building[i];
+      out.road[j] = prior.road[i];
+      out.other[j] = prior.other[i];
+    }
+  }
+}
+
+void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out)
+{
+  const std::size_t n = grid.numCells();
+  out.resize(n);
+  const float* omega = grid.plane(FrameMG::kOmega);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    int best = 0;
+    for (int e = 1; e < FrameMG::kSize; ++e)
+      if (betp[e][i] > betp[best][i]) best = e;
+    const bool known = omega[i] < 1.0f - kVacuousTolerance && betp[best][i] >= threshold;
+    out[i] = known ? static_cast<std::int8_t>(best) : static_cast<std::int8_t>(CellClass::kUnknown);
+  }
+}
+
+std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<std::int8_t>& decision,
+                                       const PignisticPlanes& betp, int min_cells)
+{
+  std::vector<GridObject> objects;
+  std::vector<std::uint8_t> seen(decision.size(), 0);
+  std::vector<std::size_t> stack, region;
+  for (std::size_t start = 0; start < decision.size(); ++start)
+  {
+    const auto cls = static_cast<CellClass>(decision[start]);
+    if (seen[start] || (cls != CellClass::kMoving && cls != CellClass::kStopped)) continue;
+    region.clear();
+    stack.assign(1, start);
+    seen[start] = 1;
+    while (!stack.empty())
+    {
+      const std::size_t i = stack.back();
+      stack.pop_back();
+      region.push_back(i);
+      const CellIndex c = g.cellOf(i);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+        {
+          const CellIndex n{ c.x + dx, c.y + dy };
+          if (!g.contains(n)) continue;
+          const std::size_t j = g.index(n);
+          if (!seen[j] && decision[j] == decision[start])
+          {
+            seen[j] = 1;
+            stack.push_back(j);
+          }
+        }
+    }
+    if (static_cast<int>(region.size()) < min_cells) continue;
+    GridObject o;
+    o.cell_class = cls;
+    o.cells = static_cast<int>(region.size());
+    const int element = static_cast<int>(cls);
+    double sx = 0, sy = 0, sb = 0;
+    for (std::size_t i : region)
+    {
+      const Point2 p = g.cellCentre(g.cellOf(i));
+      sx += p.x;
+      sy += p.y;
+      sb += betp[element][i];
+    }
+    const double n = static_cast<double>(region.size());
+    o.centroid = Point2{ sx / n, sy / n };
+    o.mean_betp = sb / n;
+    double cxx = 0, cyy = 0, cxy = 0;
+    for (std::size_t i : region)
+    {
+      const Point2 p = g.cellCentre(g.cellOf(i));
+      const double dx = p.x - o.centroid.x, dy = p.y - o.centroid.y;
+      cxx += dx * dx;
+      cyy += dy * dy;
+      cxy += dx * dy;
+    }
+    o.yaw = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
+    const double ux = std::cos(o.yaw), uy = std::sin(o.yaw);
+    double lo_u = std::numeric_limits<double>::max(), hi_u = -lo_u, lo_v = lo_u, hi_v = -lo_u;
+    for (std::size_t i : region)
+    {
+      const Point2 p = g.cellCentre(g.cellOf(i));
+      const double dx = p.x - o.centroid.x, dy = p.y - o.centroid.y;
+      const double u = dx * ux + dy * uy, v = -dx * uy + dy * ux;
+      lo_u = std::min(lo_u, u);
+      hi_u = std::max(hi_u, u);
+      lo_v = std::min(lo_v, v);
+      hi_v = std::max(hi_v, v);
+    }
+    o.length = hi_u - lo_u + g.resolution;
+    o.width = hi_v - lo_v + g.resolution;
+    objects.push_back(o);
+  }
+  return objects;
+}
+
+MapGrid::MapGrid(const MapGridParams& params)
+{
+  setParams(params);
+}
+
+void MapGrid::setParams(const MapGridParams& params)
+{
+  params.validate();
+  const GridGeometry g = GridGeometry::centred(params.size_x, params.size_y, params.resolution);
+  const bool realloc =
+      grid_.geometry().width != g.width || grid_.geometry().height != g.height || grid_.geometry().resolution != g.resolution;
+  params_ = params;
+  if (realloc)
+  {
+    grid_.reset(g);
+    scans_ = 0;
+  }
+}
+
+void MapGrid::reset()
+{
+  grid_.fillVacuous();
+  scans_ = 0;
+  last_stamp_ = 0.0;
+}
+
+void MapGrid::shift(int dx, int dy)
+{
+  if (dx == 0 && dy == 0) return;
+  const GridGeometry g = grid_.geometry();
+  grid_.setOrigin(g.origin_x + dx * g.resolution, g.origin_y + dy * g.resolution);
+  if (std::abs(dx) >= g.width || std::abs(dy) >= g.height)
+  {
+    grid_.fillVacuous();
+    return;
+  }
+  const std::size_t w = static_cast<std::size_t>(g.width);
+  const int x0 = std::max(0, -dx), x1 = std::min(g.width, g.width - dx);
+  const std::size_t count = static_cast<std::size_t>(x1 - x0);
+  const bool forward = dy > 0 || (dy == 0 && dx > 0);
+  for (int plane = 0; plane <= FrameMG::kNumSubsets; ++plane)
+  {
+    float* p = plane == FrameMG::kNumSubsets ? grid_.counter() : grid_.plane(static_cast<Subset>(plane));
+    const float fill = plane == FrameMG::kOmega ? 1.0f : 0.0f;
+    for (int k = 0; k < g.height; ++k)
+    {
+      const int y = forward ? k : g.height - 1 - k;
+      float* row = p + static_cast<std::size_t>(y) * w;
+      const int sy = y + dy;
+      if (sy < 0 || sy >= g.height)
+      {
+        std::fill(row, row + w, fill);
+        continue;
+      }
+      const float* src = p + static_cast<std::size_t>(sy) * w;
+      std::memmove(row + x0, src + x0 + dx, count * sizeof(float));
+      std::fill(row, row + x0, fill);
+      std::fill(row + x1, row + w, fill);
+    }
+  }
+}
+
+void MapGrid::recentre(Point2 p)
+{
+  const GridGeometry& g = grid_.geometry();
+  const Point2 target = snappedOrigin(g, p);
+  const int dx = static_cast<int>(std::lround((target.x - g.origin_x) / g.resolution));
+  const int dy = static_cast<int>(std::lround((target.y - g.origin_y) / g.resolution));
+  shift(dx, dy);
+}
+
+FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, double stamp, const PriorWindow* prior,
+                                StageTimes* times)
+{
+  StageTimes t;
+  auto t0 = std::chrono::steady_clock::now();
+  if (scans_ == 0)
+  {
+    grid_.fillVacuous();
+    const Point2 o = snappedOrigin(grid_.geometry(), Point2{ pose.x, pose.y });
+    grid_.setOrigin(o.x, o.y);
+  }
+  else
+  {
+    recentre(Point2{ pose.x, pose.y });
+  }
+  t.shift = secondsSince(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  projectScan(scan, pose, grid_.geometry(), scan_window_);
+  t.project_scan = secondsSince(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  if (prior) extractPriorWindow(*prior, grid_.geometry(), prior_window_);
+  t.prior_window = secondsSince(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  FusionParams fp = params_.fusion;
+  if (params_.rates_per_second && scans_ > 0) fp.discount = fp.discount.compounded(std::max(0.0, stamp - last_stamp_));
+  FusionStepStats stats;
+  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats);
+  t.fusion = secondsSince(t0);
+
+  last_stamp_ = stamp;
+  ++scans_;
+  if (times) *times = t;
+  return stats;
+}
+
+}  // namespace core
+}  // namespace map_aided_fusion

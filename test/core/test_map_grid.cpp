@@ -1,0 +1,414 @@
+// The MapGrid on scripted scenes, without ROS.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/pignistic.hpp"
+#include "test_util.hpp"
+
+using namespace map_aided_fusion::core;
+
+namespace {
+
+constexpr double kRes = 0.5;
+const MassSG kFreeScan{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } };
+const MassSG kOccupiedScan{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } };
+
+struct Box
+{
+  double x0, y0, x1, y1;  // map frame, metres
+  bool contains(Point2 p) const { return p.x >= x0 && p.x < x1 && p.y >= y0 && p.y < y1; }
+};
+
+/// A ScanGrid in the vehicle frame (vehicle at the map origin, yaw 0): cells inside a box are occupied,
+/// every other cell within @p range is seen free. No occlusion.
+ScanMassGrid scriptedScan(const std::vector<Box>& boxes, double range = 20.0)
+{
+  ScanMassGrid scan(GridGeometry::centred(50.0, 50.0, kRes));
+  const auto& g = scan.geometry();
+  for (std::size_t i = 0; i < scan.numCells(); ++i)
+  {
+    const Point2 p = g.cellCentre(g.cellOf(i));
+    bool occupied = false;
+    for (const auto& b : boxes) occupied = occupied || b.contains(p);
+    if (occupied)
+      scan.setCell(i, kOccupiedScan);
+    else if (std::hypot(p.x, p.y) <= range)
+      scan.setCell(i, kFreeScan);
+  }
+  return scan;
+}
+
+/// A prior over 100 m × 100 m: a road y ∈ [−4, 4), pavements (T) elsewhere, a building x,y ∈ [10, 16) × [8, 14).
+PriorWindow scriptedPrior()
+{
+  const auto g = GridGeometry::centred(100.0, 100.0, kRes);
+  PriorWindow prior(g);
+  const PriorConfidence beta;
+  for (std::size_t i = 0; i < g.numCells(); ++i)
+  {
+    const Point2 p = g.cellCentre(g.cellOf(i));
+    PriorClass c = PriorClass::kOther;
+    if (p.y >= -4.0 && p.y < 4.0) c = PriorClass::kRoad;
+    if (p.x >= 10.0 && p.x < 16.0 && p.y >= 8.0 && p.y < 14.0) c = PriorClass::kBuilding;
+    const auto m = priorMass(c, beta);
+    prior.building[i] = static_cast<float>(m[FrameMG::kBuilding]);
+    prior.road[i] = static_cast<float>(m[FrameMG::kRoad]);
+    prior.other[i] = static_cast<float>(m[FrameMG::kOther]);
+  }
+  return prior;
+}
+
+struct Outputs
+{
+  PignisticPlanes betp;
+  std::vector<std::int8_t> decision;
+};
+
+Outputs outputs(const MapGrid& mg)
+{
+  Outputs o;
+  pignisticGrid(mg.masses(), o.betp);
+  decide(mg.masses(), o.betp, mg.params().decision_threshold, o.decision);
+  return o;
+}
+
+CellClass classAt(const MapGrid& mg, const Outputs& o, Point2 p)
+{
+  CellIndex c;
+  EXPECT_TRUE(mg.geometry().worldToCell(p, c));
+  return static_cast<CellClass>(o.decision[mg.geometry().index(c)]);
+}
+
+MapGridParams defaultParams()
+{
+  MapGridParams p;
+  p.size_x = p.size_y = 60.0;
+  p.resolution = kRes;
+  return p;
+}
+
+}  // namespace
+
+TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
+{
+  MapGridParams params = defaultParams();
+  params.size_x = 20.0;
+  params.size_y = 15.0;
+  MapGrid mg(params);
+  std::mt19937 rng(3);
+  auto& grid = mg.masses();
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    grid.setCell(i, maf_test::randomMass<FrameMG>(rng, 6));
+    grid.counter()[i] = static_cast<float>(i % 17) / 17.0f;
+  }
+  const MapMassGrid before = grid;
+  for (auto [dx, dy] : { std::pair{ 3, -2 }, std::pair{ -5, 0 }, std::pair{ 0, 4 }, std::pair{ 1, 1 } })
+  {
+    MapGrid moved = mg;
+    moved.shift(dx, dy);
+    const auto& g = moved.geometry();
+    EXPECT_DOUBLE_EQ(g.origin_x, before.geometry().origin_x + dx * kRes);
+    EXPECT_DOUBLE_EQ(g.origin_y, before.geometry().origin_y + dy * kRes);
+    for (int y = 0; y < g.height; ++y)
+      for (int x = 0; x < g.width; ++x)
+      {
+        const std::size_t j = g.index(x, y);
+        const CellIndex src{ x + dx, y + dy };
+        if (g.contains(src))
+        {
+          const std::size_t i = g.index(src);
+          for (int a = 0; a < 32; ++a)
+            ASSERT_EQ(moved.masses().plane(static_cast<Subset>(a))[j], before.plane(static_cast<Subset>(a))[i]);
+          ASSERT_EQ(moved.masses().counter()[j], before.counter()[i]);
+          // Same world position before and after.
+          const Point2 pw = g.cellCentre(CellIndex{ x, y });
+          const Point2 pb = before.geometry().cellCentre(src);
+          ASSERT_DOUBLE_EQ(pw.x, pb.x);
+          ASSERT_DOUBLE_EQ(pw.y, pb.y);
+        }
+        else
+        {
+          ASSERT_TRUE(maf_test::massNear(moved.masses().cell(j), MassMG::vacuous(), 0.0));
+          ASSERT_EQ(moved.masses().counter()[j], 0.0f);
+        }
+      }
+  }
+  MapGrid far = mg;
+  far.shift(1000, 0);
+  for (std::size_t i = 0; i < far.masses().numCells(); ++i)
+    ASSERT_TRUE(maf_test::massNear(far.masses().cell(i), MassMG::vacuous(), 0.0));
+}
+
+TEST(ProjectScan, IdentityIsAnExactCopyAndRotationLosesNoObstacle)
+{
+  const auto sg = GridGeometry::centred(20.0, 20.0, kRes);
+  ScanMassGrid scan(sg);
+  std::mt19937 rng(4);
+  for (std::size_t i = 0; i < scan.numCells(); ++i) scan.setCell(i, maf_test::randomMass<FrameSG>(rng, 3));
+  ScanMassGrid out;
+  projectScan(scan, Pose2{ 0.0, 0.0, 0.0 }, sg, out);
+  for (std::size_t i = 0; i < scan.numCells(); ++i)
+    for (int a = 0; a < 4; ++a) ASSERT_EQ(out.plane(static_cast<Subset>(a))[i], scan.plane(static_cast<Subset>(a))[i]);
+
+  // A window translated by whole cells and a vehicle away from the origin: still a copy.
+  auto window = sg;
+  window.origin_x += 7 * kRes;
+  window.origin_y -= 3 * kRes;
+  projectScan(scan, Pose2{ 2.0, -1.0, 0.0 }, window, out);
+  for (int y = 0; y < window.height; ++y)
+    for (int x = 0; x < window.width; ++x)
+    {
+      const Point2 p = window.cellCentre(CellIndex{ x, y });
+      CellIndex sc;
+      const bool inside = sg.worldToCell(Point2{ p.x - 2.0, p.y + 1.0 }, sc);
+      const auto expected = inside ? scan.cell(sg.index(sc)) : MassSG::vacuous();
+      ASSERT_TRUE(maf_test::massNear(out.cell(window.index(x, y)), expected, 0.0));
+    }
+
+  // One occupied cell per scan at many angles: it always reaches the window.
+  for (double yaw = 0.0; yaw < 6.3; yaw += 0.1)
+  {
+    ScanMassGrid pole(sg);
+    const std::size_t k = sg.index(27, 13);
+    pole.setCell(k, kOccupiedScan);
+    projectScan(pole, Pose2{ 1.3, -0.7, yaw }, GridGeometry::centred(40.0, 40.0, kRes), out);
+    int occupied = 0;
+    for (std::size_t i = 0; i < out.numCells(); ++i) occupied += out.plane(FrameSG::kO)[i] > 0.0f;
+    EXPECT_GE(occupied, 1) << "yaw " << yaw;
+  }
+}
+
+TEST(ExtractPriorWindow, CopiesAlignedCellsAndIsVacuousOutside)
+{
+  const PriorWindow prior = scriptedPrior();
+  auto window = GridGeometry::centred(20.0, 20.0, kRes, 45.0, 0.0);  // half outside the prior
+  PriorWindow out;
+  extractPriorWindow(prior, window, out);
+  for (int y = 0; y < window.height; ++y)
+    for (int x = 0; x < window.width; ++x)
+    {
+      const Point2 p = window.cellCentre(CellIndex{ x, y });
+      const std::size_t j = window.index(x, y);
+      CellIndex pc;
+      if (prior.geometry.worldToCell(p, pc))
+      {
+        ASSERT_EQ(out.road[j], prior.road[prior.geometry.index(pc)]);
+        ASSERT_EQ(out.other[j], prior.other[prior.geometry.index(pc)]);
+      }
+      else
+      {
+        ASSERT_EQ(out.building[j] + out.road[j] + out.other[j], 0.0f);
+      }
+    }
+}
+
+TEST(MapGridScene, CarCrossingIsMovingAndLeavesNoTrail)
+{
+  MapGrid mg(defaultParams());
+  const PriorWindow prior = scriptedPrior();
+  // Free road for 1 s, then a 4 m × 2 m car driving at 10 m/s (one metre per scan) along y = 0.
+  for (int t = 0; t < 10; ++t) mg.update(scriptedScan({}), Pose2{}, 0.1 * t, &prior);
+  double x_car = -15.0;
+  for (int t = 10; t < 40; ++t, x_car += 1.0)
+  {
+    mg.update(scriptedScan({ Box{ x_car, -1.0, x_car + 4.0, 1.0 } }), Pose2{}, 0.1 * t, &prior);
+    if (t < 13) continue;
+    const auto o = outputs(mg);
+    EXPECT_EQ(classAt(mg, o, Point2{ x_car + 3.75, 0.25 }), CellClass::kMoving) << "front of the car at scan " << t;
+    // Where the car was 1 s ago (10 scans), no V is left.
+    if (t >= 22)
+    {
+      for (double x = x_car - 10.0; x < x_car - 6.0; x += kRes)
+        EXPECT_NE(classAt(mg, o, Point2{ x + 0.25, 0.25 }), CellClass::kMoving) << "trail at x=" << x << " scan " << t;
+    }
+  }
+  const auto o = outputs(mg);
+  const auto objects = extractObjects(mg.geometry(), o.decision, o.betp, mg.params().min_object_cells);
+  int moving = 0;
+  for (const auto& obj : objects)
+    if (obj.cell_class == CellClass::kMoving)
+    {
+      ++moving;
+      EXPECT_NEAR(obj.centroid.y, 0.0, 1.0);
+      EXPECT_GT(obj.centroid.x, x_car - 3.0);
+    }
+  EXPECT_GE(moving, 1);
+}
+
+TEST(MapGridScene, BusThatStopsEndsStopped)
+{
+  MapGrid mg(defaultParams());
+  const PriorWindow prior = scriptedPrior();
+  for (int t = 0; t < 10; ++t) mg.update(scriptedScan({}), Pose2{}, 0.1 * t, &prior);
+  // A 12 m bus drives 1 m per scan for 5 scans, then stays for 5 s.
+  double x = -20.0;
+  int t = 10;
+  for (; t < 15; ++t, x += 1.0) mg.update(scriptedScan({ Box{ x, -1.5, x + 12.0, 1.5 } }), Pose2{}, 0.1 * t, &prior);
+  const Box parked{ x, -1.5, x + 12.0, 1.5 };
+  for (; t < 65; ++t) mg.update(scriptedScan({ parked }), Pose2{}, 0.1 * t, &prior);
+  const auto o = outputs(mg);
+  int stopped = 0, moving = 0, cells = 0;
+  for (double px = parked.x0 + 0.25; px < parked.x1; px += kRes)
+    for (double py = parked.y0 + 0.25; py < parked.y1; py += kRes)
+    {
+      const auto c = classAt(mg, o, Point2{ px, py });
+      stopped += c == CellClass::kStopped;
+      moving += c == CellClass::kMoving;
+      ++cells;
+    }
+  EXPECT_GT(stopped, cells * 9 / 10);
+  EXPECT_EQ(moving, 0);
+}
+
+TEST(MapGridScene, PoleOnPavementIsInfrastructureOrStoppedNeverMoving)
+{
+  MapGrid mg(defaultParams());
+  const PriorWindow prior = scriptedPrior();
+  const Box pole{ 5.0, 6.0, 5.5, 6.5 };  // on the pavement (T)
+  for (int t = 0; t < 40; ++t)
+  {
+    mg.update(scriptedScan({ pole }), Pose2{}, 0.1 * t, &prior);
+    const auto o = outputs(mg);
+    const auto c = classAt(mg, o, Point2{ 5.25, 6.25 });
+    EXPECT_NE(c, CellClass::kMoving) << "scan " << t;
+    if (t > 5)
+    {
+      EXPECT_TRUE(c == CellClass::kInfrastructure || c == CellClass::kStopped) << "scan " << t;
+    }
+  }
+  const auto m = mg.masses().cell(mg.geometry().index(mg.geometry().cellAt(Point2{ 5.25, 6.25 })));
+  EXPECT_LT(m[FrameMG::kV], 1e-3);
+}
+
+TEST(MapGridScene, BuildingIsCWithPriorAndAmbiguousWithout)
+{
+  const Box wall{ 10.0, 8.0, 16.0, 14.0 };
+  const Point2 inside{ 12.25, 10.25 };
+  for (bool with_prior : { true, false })
+  {
+    MapGrid mg(defaultParams());
+    const PriorWindow prior = scriptedPrior();
+    for (int t = 0; t < 30; ++t) mg.update(scriptedScan({ wall }), Pose2{}, 0.1 * t, with_prior ? &prior : nullptr);
+    const auto o = outputs(mg);
+    const auto m = mg.masses().cell(mg.geometry().index(mg.geometry().cellAt(inside)));
+    int largest = 1;
+    for (int a = 2; a < 32; ++a)
+      if (m[a] > m[largest]) largest = a;
+    if (with_prior)
+    {
+      EXPECT_EQ(classAt(mg, o, inside), CellClass::kBuilding);
+      EXPECT_EQ(largest, FrameMG::kC);
+    }
+    else
+    {
+      // Occupied without knowing by what: the mass stays on a set of several occupied classes.
+      EXPECT_TRUE(isSubsetOf(static_cast<Subset>(largest), FrameMG::kO)) << subsetName<FrameMG>(largest);
+      EXPECT_GE(cardinality(static_cast<Subset>(largest)), 3) << subsetName<FrameMG>(largest);
+      EXPECT_NE(classAt(mg, o, inside), CellClass::kBuilding);
+      EXPECT_NE(classAt(mg, o, inside), CellClass::kMoving);
+    }
+  }
+}
+
+TEST(MapGrid, FollowsTheVehicleByWholeCells)
+{
+  MapGrid mg(defaultParams());
+  mg.update(scriptedScan({}), Pose2{ 0.0, 0.0, 0.0 }, 0.0, nullptr);
+  const auto g0 = mg.geometry();
+  mg.update(scriptedScan({}), Pose2{ 3.3, -1.1, 0.2 }, 0.1, nullptr);
+  const auto g1 = mg.geometry();
+  const double sx = (g1.origin_x - g0.origin_x) / kRes, sy = (g1.origin_y - g0.origin_y) / kRes;
+  EXPECT_DOUBLE_EQ(sx, std::round(sx));
+  EXPECT_DOUBLE_EQ(sy, std::round(sy));
+  EXPECT_NEAR(g1.origin_x + 0.5 * g1.sizeX(), 3.3, kRes);
+  EXPECT_NEAR(g1.origin_y + 0.5 * g1.sizeY(), -1.1, kRes);
+  EXPECT_EQ(mg.scans(), 2u);
+  mg.reset();
+  EXPECT_EQ(mg.scans(), 0u);
+}
+
+TEST(MapGrid, RatesPerSecondForgetByElapsedTime)
+{
+  MapGridParams p = defaultParams();
+  p.rates_per_second = true;
+  p.fusion.discount = ContextualRates{ 0.1, 0.5, 0.3 };
+  MapGrid a(p), b(p);
+  const auto occupied = scriptedScan({ Box{ 2.0, 2.0, 3.0, 3.0 } });
+  const auto nothing = scriptedScan({}, 0.0);
+  a.update(occupied, Pose2{}, 0.0, nullptr);
+  b.update(occupied, Pose2{}, 0.0, nullptr);
+  // a: one empty scan 2 s later; expected: the reference step with rates 1 − (1 − α)^2.
+  a.update(nothing, Pose2{}, 2.0, nullptr);
+  const std::size_t k = b.geometry().index(b.geometry().cellAt(Point2{ 2.25, 2.25 }));
+  FusionParams two_seconds = p.fusion;
+  two_seconds.discount = p.fusion.discount.compounded(2.0);
+  const auto expected = fuseCell(b.masses().cell(k), b.masses().counter()[k], MassSG::vacuous(), MassMG::vacuous(),
+                                 two_seconds);
+  EXPECT_TRUE(maf_test::massNear(a.masses().cell(k), expected.mass, 1e-5));
+  const auto per_scan = fuseCell(b.masses().cell(k), b.masses().counter()[k], MassSG::vacuous(), MassMG::vacuous(),
+                                 p.fusion);
+  EXPECT_FALSE(maf_test::massNear(a.masses().cell(k), per_scan.mass, 1e-3)) << "2 s must forget more than one scan";
+}
+
+TEST(MapGrid, RejectsBadParametersNamingThem)
+{
+  MapGridParams p = defaultParams();
+  p.resolution = -1.0;
+  try
+  {
+    MapGrid mg(p);
+    FAIL();
+  }
+  catch (const ParameterError& e)
+  {
+    EXPECT_EQ(e.parameter(), "resolution");
+  }
+  p = defaultParams();
+  p.min_object_cells = 0;
+  EXPECT_THROW(MapGrid{ p }, ParameterError);
+  p = defaultParams();
+  p.size_x = 1e6;
+  EXPECT_THROW(MapGrid{ p }, ParameterError);
+}
+
+TEST(Objects, ConnectedRegionsWithExtentAndClass)
+{
+  const GridGeometry g{ 1.0, 10, 8, 0.0, 0.0 };
+  std::vector<std::int8_t> decision(g.numCells(), static_cast<std::int8_t>(CellClass::kFree));
+  PignisticPlanes betp;
+  for (auto& p : betp.p) p.assign(g.numCells(), 0.0f);
+  // A 4 × 2 moving block at x ∈ [1, 5), y ∈ [1, 3) and a stopped 2 × 3 block at x ∈ [7, 9), y ∈ [4, 7).
+  for (int y = 1; y < 3; ++y)
+    for (int x = 1; x < 5; ++x)
+    {
+      decision[g.index(x, y)] = static_cast<std::int8_t>(CellClass::kMoving);
+      betp.p[4][g.index(x, y)] = 0.8f;
+    }
+  for (int y = 4; y < 7; ++y)
+    for (int x = 7; x < 9; ++x)
+    {
+      decision[g.index(x, y)] = static_cast<std::int8_t>(CellClass::kStopped);
+      betp.p[3][g.index(x, y)] = 0.6f;
+    }
+  decision[g.index(0, 7)] = static_cast<std::int8_t>(CellClass::kMoving);  // a single cell: noise
+  const auto objects = extractObjects(g, decision, betp, 3);
+  ASSERT_EQ(objects.size(), 2u);
+  const auto& car = objects[0].cell_class == CellClass::kMoving ? objects[0] : objects[1];
+  const auto& bus = objects[0].cell_class == CellClass::kMoving ? objects[1] : objects[0];
+  EXPECT_EQ(car.cells, 8);
+  EXPECT_NEAR(car.centroid.x, 3.0, 1e-9);
+  EXPECT_NEAR(car.centroid.y, 2.0, 1e-9);
+  EXPECT_NEAR(car.length, 4.0, 1e-9);
+  EXPECT_NEAR(car.width, 2.0, 1e-9);
+  EXPECT_NEAR(std::abs(std::cos(car.yaw)), 1.0, 1e-9);
+  EXPECT_NEAR(car.mean_betp, 0.8, 1e-6);
+  EXPECT_EQ(bus.cell_class, CellClass::kStopped);
+  EXPECT_EQ(bus.cells, 6);
+  EXPECT_NEAR(bus.length, 3.0, 1e-9);
+  EXPECT_NEAR(bus.width, 2.0, 1e-9);
+  EXPECT_NEAR(bus.centroid.x, 8.0, 1e-9);
+  EXPECT_NEAR(bus.centroid.y, 5.5, 1e-9);
+}

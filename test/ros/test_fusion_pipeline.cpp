@@ -1,0 +1,268 @@
+// rostest of the whole pipeline (map loader, scan grid and fusion nodelets in one manager): a synthetic
+// lidar on a vehicle standing at a road sees a car drive across; the car must be published as moving.
+// Then a scan without a transform must be dropped and counted, and a jump back in time must reset.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <visualization_msgs/MarkerArray.h>
+
+namespace {
+
+constexpr double kLidarHeight = 1.8;
+constexpr double kScanPeriod = 0.1;
+
+struct Box
+{
+  double x0, y0, x1, y1, height;
+};
+
+/// 2D ray from the origin to (x, y) crosses the box footprint.
+bool rayHitsBox(double x, double y, const Box& b)
+{
+  double t0 = 0.0, t1 = 1.0;
+  const double d[2] = { x, y }, lo[2] = { b.x0, b.y0 }, hi[2] = { b.x1, b.y1 };
+  for (int k = 0; k < 2; ++k)
+  {
+    if (std::abs(d[k]) < 1e-12)
+    {
+      if (0.0 < lo[k] || 0.0 > hi[k]) return false;
+      continue;
+    }
+    double a = lo[k] / d[k], c = hi[k] / d[k];
+    if (a > c) std::swap(a, c);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, c);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+/// A cloud in the lidar frame (lidar 1.8 m above base_link): ground rings and the faces of the boxes
+/// (all coordinates given in base_link).
+sensor_msgs::PointCloud2 makeCloud(const std::vector<Box>& boxes, const ros::Time& stamp)
+{
+  std::vector<float> xyz;
+  for (double r = 2.0; r < 30.0; r += 0.5)
+    for (double a = -M_PI; a < M_PI; a += M_PI / 360.0)
+    {
+      const double x = r * std::cos(a), y = r * std::sin(a);
+      bool hidden = false;
+      for (const auto& b : boxes) hidden = hidden || rayHitsBox(x, y, b);
+      if (hidden) continue;
+      xyz.insert(xyz.end(), { static_cast<float>(x), static_cast<float>(y), static_cast<float>(-kLidarHeight) });
+    }
+  for (const auto& b : boxes)
+    for (double z = 0.3; z < b.height; z += 0.2)
+    {
+      for (double x = b.x0; x <= b.x1; x += 0.1)
+        for (double y : { b.y0, b.y1 })
+          xyz.insert(xyz.end(), { static_cast<float>(x), static_cast<float>(y), static_cast<float>(z - kLidarHeight) });
+      for (double y = b.y0; y <= b.y1; y += 0.1)
+        for (double x : { b.x0, b.x1 })
+          xyz.insert(xyz.end(), { static_cast<float>(x), static_cast<float>(y), static_cast<float>(z - kLidarHeight) });
+    }
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = "lidar";
+  cloud.header.stamp = stamp;
+  sensor_msgs::PointCloud2Modifier mod(cloud);
+  mod.setPointCloud2FieldsByString(1, "xyz");
+  mod.resize(xyz.size() / 3);
+  sensor_msgs::PointCloud2Iterator<float> it(cloud, "x");
+  for (std::size_t i = 0; i < xyz.size(); i += 3, ++it)
+  {
+    it[0] = xyz[i];
+    it[1] = xyz[i + 1];
+    it[2] = xyz[i + 2];
+  }
+  return cloud;
+}
+
+class PipelineTest : public ::testing::Test
+{
+protected:
+  void SetUp() override
+  {
+    ros::NodeHandle pnh("~");
+    pnh.param("vehicle_x", vehicle_x_, 0.0);
+    pnh.param("vehicle_y", vehicle_y_, 0.0);
+    pnh.param("vehicle_yaw", vehicle_yaw_, 0.0);
+    pnh.param("car_lane_y", car_lane_y_, 4.0);
+    points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 10);
+    objects_sub_ = nh_.subscribe("objects", 10, &PipelineTest::onObjects, this);
+    decision_sub_ = nh_.subscribe("decision", 10, &PipelineTest::onDecision, this);
+    diagnostics_sub_ = nh_.subscribe("/diagnostics", 50, &PipelineTest::onDiagnostics, this);
+    geometry_msgs::TransformStamped lidar;
+    lidar.header.frame_id = "base_link";
+    lidar.child_frame_id = "lidar";
+    lidar.transform.translation.z = kLidarHeight;
+    lidar.transform.rotation.w = 1.0;
+    static_broadcaster_.sendTransform(lidar);
+  }
+
+  void onObjects(const visualization_msgs::MarkerArray::ConstPtr& m)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    objects_ = *m;
+  }
+  void onDecision(const nav_msgs::OccupancyGrid::ConstPtr& m)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    decision_ = *m;
+  }
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& m)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& s : m->status)
+    {
+      if (s.name.find("fusion") == std::string::npos) continue;
+      for (const auto& kv : s.values) fusion_diagnostics_[kv.key] = kv.value;
+    }
+  }
+  double diagnostic(const std::string& key)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = fusion_diagnostics_.find(key);
+    return it == fusion_diagnostics_.end() ? -1.0 : std::stod(it->second);
+  }
+
+  void sendPose(const ros::Time& stamp)
+  {
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = "map";
+    t.header.stamp = stamp;
+    t.child_frame_id = "base_link";
+    t.transform.translation.x = vehicle_x_;
+    t.transform.translation.y = vehicle_y_;
+    t.transform.rotation.z = std::sin(0.5 * vehicle_yaw_);
+    t.transform.rotation.w = std::cos(0.5 * vehicle_yaw_);
+    broadcaster_.sendTransform(t);
+  }
+
+  /// base_link → map.
+  void toMap(double bx, double by, double& mx, double& my) const
+  {
+    mx = vehicle_x_ + std::cos(vehicle_yaw_) * bx - std::sin(vehicle_yaw_) * by;
+    my = vehicle_y_ + std::sin(vehicle_yaw_) * bx + std::cos(vehicle_yaw_) * by;
+  }
+
+  void spinFor(double seconds)
+  {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < end)
+    {
+      ros::spinOnce();
+      ros::WallDuration(0.01).sleep();
+    }
+  }
+
+  ros::NodeHandle nh_;
+  double vehicle_x_ = 0, vehicle_y_ = 0, vehicle_yaw_ = 0, car_lane_y_ = 4.0;
+  ros::Publisher points_pub_;
+  ros::Subscriber objects_sub_, decision_sub_, diagnostics_sub_;
+  tf2_ros::TransformBroadcaster broadcaster_;
+  tf2_ros::StaticTransformBroadcaster static_broadcaster_;
+  std::mutex mutex_;
+  std::optional<visualization_msgs::MarkerArray> objects_;
+  std::optional<nav_msgs::OccupancyGrid> decision_;
+  std::map<std::string, std::string> fusion_diagnostics_;
+};
+
+TEST_F(PipelineTest, CarCrossingIsMovingDropsAreCountedTimeJumpsReset)
+{
+  // Wait for the manager to subscribe.
+  for (int i = 0; i < 300 && points_pub_.getNumSubscribers() == 0; ++i) spinFor(0.1);
+  ASSERT_GT(points_pub_.getNumSubscribers(), 0u) << "nobody subscribes to points";
+  spinFor(2.0);  // prior loaded and latched
+
+  const ros::Time t0 = ros::Time::now();
+  double car_x = -18.0;
+  for (int k = 0; k < 45; ++k)
+  {
+    const ros::Time stamp = t0 + ros::Duration(k * kScanPeriod);
+    sendPose(stamp);
+    std::vector<Box> boxes;
+    if (k >= 10)
+    {
+      boxes.push_back(Box{ car_x, car_lane_y_ - 1.0, car_x + 4.5, car_lane_y_ + 1.0, 1.5 });
+      car_x += 1.0;
+    }
+    spinFor(0.02);
+    points_pub_.publish(makeCloud(boxes, stamp));
+    spinFor(kScanPeriod);
+  }
+  spinFor(1.5);
+
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ASSERT_TRUE(decision_.has_value()) << "no decision layer published";
+    ASSERT_TRUE(objects_.has_value()) << "no objects published";
+    // The car's last position (base_link) → cells decided V.
+    const auto& d = *decision_;
+    int moving = 0, cells = 0;
+    for (double bx = car_x - 1.0 + 0.25; bx < car_x + 3.5; bx += 0.5)
+      for (double by = car_lane_y_ - 0.75; by < car_lane_y_ + 1.0; by += 0.5)
+      {
+        double mx, my;
+        toMap(bx, by, mx, my);
+        const int cx = static_cast<int>(std::floor((mx - d.info.origin.position.x) / d.info.resolution));
+        const int cy = static_cast<int>(std::floor((my - d.info.origin.position.y) / d.info.resolution));
+        if (cx < 0 || cy < 0 || cx >= static_cast<int>(d.info.width) || cy >= static_cast<int>(d.info.height)) continue;
+        ++cells;
+        moving += d.data[cy * d.info.width + cx] == 4;
+      }
+    EXPECT_GT(cells, 0);
+    EXPECT_GT(moving, 0) << "no cell of the car is decided moving";
+    bool moving_object = false;
+    for (const auto& m : objects_->markers)
+    {
+      if (m.ns != "objects/box" || m.color.r < 0.9) continue;
+      double mx, my;
+      toMap(car_x + 1.0, car_lane_y_, mx, my);
+      moving_object = moving_object || std::hypot(m.pose.position.x - mx, m.pose.position.y - my) < 5.0;
+    }
+    EXPECT_TRUE(moving_object) << "no moving object near the car";
+  }
+  spinFor(1.5);
+  const double fused = diagnostic("scans fused");
+  EXPECT_GE(fused, 40.0);
+  const double dropped_before = diagnostic("scans dropped (no transform)");
+  ASSERT_GE(dropped_before, 0.0) << "fusion diagnostics not received";
+
+  // A scan far older than any pose in the tf buffer: never transformable, dropped and counted.
+  points_pub_.publish(makeCloud({}, t0 - ros::Duration(30.0)));
+  spinFor(2.5);
+  EXPECT_EQ(diagnostic("scans dropped (no transform)"), dropped_before + 1.0);
+  EXPECT_EQ(diagnostic("scans fused"), fused) << "the scan without a transform was fused";
+
+  // Time jumps back (rosbag play --loop): the grid resets.
+  const double resets_before = diagnostic("grid resets (time backwards)");
+  const ros::Time back = t0 + ros::Duration(1.0);
+  sendPose(back);
+  spinFor(0.05);
+  points_pub_.publish(makeCloud({}, back));
+  spinFor(2.5);
+  EXPECT_EQ(diagnostic("grid resets (time backwards)"), resets_before + 1.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_fusion_pipeline");
+  return RUN_ALL_TESTS();
+}
