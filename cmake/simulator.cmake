@@ -25,10 +25,12 @@ if(CATKIN_ENABLE_TESTING)
     test/sim/test_motion.cpp
     test/sim/test_simulator.cpp
     test/sim/test_scenarios.cpp
+    test/sim/test_real_data.cpp
     test/test_main.cpp
   )
   target_link_libraries(test_simulator map_aided_fusion_sim)
-  target_compile_definitions(test_simulator PRIVATE MAF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  target_compile_definitions(test_simulator PRIVATE MAF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data")
 endif()
 
 if(TARGET bench_map_aided_fusion)

@@ -23,6 +23,15 @@ const std::vector<double> kVlp32Elevations{ -25.0,  -15.639, -11.31, -8.843, -7.
                                             -1.333, -1.0,    -0.667, -0.333, 0.0,    0.333,  0.667,  1.0,
                                             1.333,  1.667,   2.333,  3.333,  4.667,  7.0,    10.333, 15.0 };
 
+std::vector<double> hdl32Elevations()
+{
+  constexpr int kBeams = 32;
+  constexpr double kLowest = -30.67, kStep = 4.0 / 3.0;
+  std::vector<double> e;
+  for (int i = 0; i < kBeams; ++i) e.push_back(kLowest + i * kStep);
+  return e;
+}
+
 std::vector<double> hdl64Elevations()
 {
   constexpr int kBlock = 32;
@@ -91,6 +100,14 @@ LidarParams LidarParams::fromPreset(const std::string& name)
     p.azimuth_resolution_deg = 0.2;
     p.max_range = 100.0;
   }
+  else if (name == "hdl32")
+  {
+    p.elevations_deg = hdl32Elevations();
+    p.azimuth_resolution_deg = 0.16;
+    p.max_range = 100.0;
+    p.mount_x = 0.94;
+    p.mount_z = 1.84;
+  }
   else if (name == "hdl64")
   {
     p.elevations_deg = hdl64Elevations();
@@ -99,12 +116,12 @@ LidarParams LidarParams::fromPreset(const std::string& name)
   }
   else
   {
-    throw core::ParameterError("lidar.preset", "unknown preset '" + name + "' (ibeo4, vlp32, hdl64)");
+    throw core::ParameterError("lidar.preset", "unknown preset '" + name + "' (ibeo4, vlp32, hdl32, hdl64)");
   }
   return p;
 }
 
-std::vector<std::string> lidarPresetNames() { return { "ibeo4", "vlp32", "hdl64" }; }
+std::vector<std::string> lidarPresetNames() { return { "ibeo4", "vlp32", "hdl32", "hdl64" }; }
 
 }  // namespace sim
 }  // namespace map_aided_fusion

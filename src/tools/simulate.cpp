@@ -1,5 +1,5 @@
 // rosrun map_aided_fusion simulate --scenario scenarios/default.yaml --out x.bag
-//   [--duration S] [--preset ibeo4|vlp32|hdl64] [--seed N] [--quiet]
+//   [--duration S] [--preset ibeo4|vlp32|hdl32|hdl64] [--seed N] [--quiet]
 // Loads the scenario and its map, simulates every scan and writes the bag (see ros/sim_bag.hpp).
 #include <cstdlib>
 #include <iostream>
@@ -21,7 +21,7 @@ constexpr int kRunError = 1;
 
 void usage(std::ostream& out)
 {
-  out << "usage: simulate --scenario FILE.yaml --out FILE.bag [--duration S] [--preset ibeo4|vlp32|hdl64]"
+  out << "usage: simulate --scenario FILE.yaml --out FILE.bag [--duration S] [--preset ibeo4|vlp32|hdl32|hdl64]"
          " [--seed N] [--quiet]\n"
          "Simulates an urban scenario (lidar, ego pose, ground truth) and writes a rosbag with /points, /tf,\n"
          "/tf_static, /ground_truth/classes and /ground_truth/objects.\n";

@@ -121,6 +121,19 @@ TEST(SimSimulator, GroundTruthCodesAndUnknownCells)
   EXPECT_NEAR(f.objects[2].length, 0.3, 1e-12);
 }
 
+TEST(SimSimulator, RaysWithoutReturnCanCountAsObserved)
+{
+  Scenario sc = smallScenario();
+  sc.ground_truth.include_no_return_rays = true;
+  Simulator sim(sc, smallMap());
+  ScanFrame f;
+  sim.scan(0, f);
+  EXPECT_EQ(classAt(f, -35.25, 35.25), 0);   // 49.8 m along a ray without return: within max range (60 m)
+  EXPECT_EQ(classAt(f, -49.75, 49.75), -1);  // 70.4 m: beyond
+  EXPECT_EQ(classAt(f, 20.25, 0.25), -1);   // still hidden behind A
+  EXPECT_EQ(classAt(f, 10.25, 0.25), 1);
+}
+
 TEST(SimSimulator, PointsAreExactWithoutNoise)
 {
   Simulator sim(smallScenario(), smallMap());

@@ -49,6 +49,8 @@ struct LidarParams
    * - `vlp32`: Velodyne VLP-32C, 32 beams from -25 to +15 deg (denser near the horizon), 0.2 deg over 360 deg
    *   (57 600 rays), roof mount (x 1.2 m, z 1.9 m), max range 100 m (the sensor's 200 m is never reached in a
    *   town).
+   * - `hdl32`: Velodyne HDL-32E (the nuScenes lidar), 32 beams from -30.67 to +10.67 deg every 4/3 deg,
+   *   0.16 deg over 360 deg (72 000 rays), mount as on the nuScenes car (x 0.94 m, z 1.84 m), max range 100 m.
    * - `hdl64`: Velodyne HDL-64E, 64 beams from -24.33 to +2 deg, 0.18 deg over 360 deg (128 000 rays), roof
    *   mount, max range 120 m.
    * @throws core::ParameterError for an unknown name.

@@ -95,6 +95,9 @@ public:
    * @param slopes    tan(elevation) of each beam
    * @param max_s     horizontal reach of each beam (max range · cos(elevation)); hits beyond are dropped
    * @param hits      output, one per beam: the nearest hit (solid or ground) within reach, else kNone
+   *
+   * The origin must not stand inside a solid's footprint (hits behind a footprint that contains the origin
+   * may then be missed).
    */
   void castFan(double ox, double oy, double oz, double azimuth, const double* slopes, const double* max_s, int n,
                BeamHit* hits) const;
