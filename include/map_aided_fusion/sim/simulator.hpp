@@ -59,7 +59,15 @@ struct ScanFrame
   std::size_t no_return = 0;   ///< rays without anything within range
   std::size_t dropped = 0;     ///< returns lost to dropout or outside [min_range, max_range] after noise
   core::GridGeometry truth_geometry;  ///< ground-truth window (map frame)
-  std::vector<std::int8_t> truth_classes;  ///< core::CellClass codes, -1 where no ray could have seen
+  /**
+   * core::CellClass codes per cell of truth_geometry (row-major, like nav_msgs/OccupancyGrid), and -1 where no
+   * ray of this scan could have seen: a cell is observed when the 2D projection of a ray passes through it up
+   * to and including the cell of the ray's noise-free hit (returns lost to dropout still count; rays without
+   * any hit count up to their max range only with ground_truth.include_no_return_rays). Classes: mapped
+   * buildings C, buildings missing from the map N, objects by their class (the larger code wins where
+   * footprints share a cell), the rest F; a cell belongs to a footprint when they overlap.
+   */
+  std::vector<std::int8_t> truth_classes;
   std::vector<ObjectTruth> objects;        ///< objects present at this instant
 };
 
