@@ -74,3 +74,43 @@ void BM_CastFan32(benchmark::State& state)
 BENCHMARK(BM_CastFan32);
 
 }  // namespace
+
+#ifdef MAF_SIM_BENCH_MAP_IO
+#include <filesystem>
+
+#include "map_aided_fusion/map_io/map_loader.hpp"
+
+namespace {
+
+/// One scan in Monaco (23 k buildings, ../shared/data): the acceleration grid on a real dense city.
+void BM_SimulateScanMonaco(benchmark::State& state)
+{
+  const std::string path = std::string(MAF_SIM_SHARED_DATA_DIR) + "/osm/monaco.osm.pbf";
+  if (!std::filesystem::exists(path))
+  {
+    state.SkipWithError("SKIPPED: ../shared/data/osm/monaco.osm.pbf is absent");
+    return;
+  }
+  map_aided_fusion::map_io::MapLoadParams p;
+  p.file = path;
+  const auto map = map_aided_fusion::map_io::loadVectorMap(p);
+  Scenario sc;
+  sc.duration = 10.0;
+  sc.lidar = LidarParams::fromPreset(presetOf(static_cast<int>(state.range(0))));
+  const auto& line = map.road_lines[map.road_lines.size() / 2];
+  sc.ego.route = line.points;
+  sc.ego.motion.speed = 8.0;
+  Simulator sim(sc, map);
+  ScanFrame frame;
+  int k = 0;
+  for (auto _ : state)
+  {
+    sim.scan(k, frame);
+    k = (k + 1) % sim.numScans();
+  }
+  state.counters["points/scan"] = static_cast<double>(frame.points.size());
+}
+BENCHMARK(BM_SimulateScanMonaco)->Arg(32)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+#endif

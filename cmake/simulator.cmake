@@ -36,6 +36,11 @@ endif()
 if(TARGET bench_map_aided_fusion)
   target_sources(bench_map_aided_fusion PRIVATE bench/bench_simulator.cpp)
   target_link_libraries(bench_map_aided_fusion map_aided_fusion_sim)
+  if(TARGET map_aided_fusion_map_io)
+    target_link_libraries(bench_map_aided_fusion map_aided_fusion_map_io)
+    target_compile_definitions(bench_map_aided_fusion PRIVATE MAF_SIM_BENCH_MAP_IO
+      MAF_SIM_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data")
+  endif()
 endif()
 
 # ROS layer: message converters and the rosbag writer over the ROS-free simulator.
@@ -58,4 +63,12 @@ endif()
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_sim_bag test/ros/test_sim_bag.cpp test/test_main.cpp)
   target_link_libraries(test_sim_bag map_aided_fusion_sim_bag)
+endif()
+
+# Tests on maps read by the loader (town.osm, and the real Monaco extract when ../shared/data exists).
+if(CATKIN_ENABLE_TESTING AND TARGET map_aided_fusion_map_io)
+  catkin_add_gtest(test_sim_maps test/sim/test_sim_maps.cpp test/test_main.cpp)
+  target_link_libraries(test_sim_maps map_aided_fusion_sim map_aided_fusion_map_io)
+  target_compile_definitions(test_sim_maps PRIVATE MAF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data")
 endif()
