@@ -1,0 +1,108 @@
+/**
+ * @file scenario.hpp
+ * @brief A simulation scenario (map, ego route, objects with paths, speeds and stops, map errors, lidar,
+ *        seed, duration) and its YAML loader. See scenarios/default.yaml for the documented format.
+ */
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "map_aided_fusion/core/cell_class.hpp"
+#include "map_aided_fusion/sim/lidar.hpp"
+#include "map_aided_fusion/sim/motion.hpp"
+#include "map_aided_fusion/sim/scene.hpp"
+
+namespace map_aided_fusion {
+namespace sim {
+
+/// One object of a scenario (a path of one point is a static object).
+struct ObjectSpec
+{
+  std::uint32_t id = 0;
+  std::string kind = "car";  ///< car, bus, truck, pedestrian, cyclist, pole, bin, tree, box
+  WorldObject::Shape shape = WorldObject::Shape::kBox;
+  double length = 4.5;  ///< m (boxes)
+  double width = 1.8;   ///< m (boxes)
+  double height = 1.5;  ///< m
+  double radius = 0.3;  ///< m (cylinders)
+  double z_min = 0.0;   ///< m, height of the object's underside
+  double yaw_deg = 0.0; ///< heading of a static object (one-point path)
+  bool movable = true;  ///< vehicles and people: S when stopped, V when moving; others: N
+  /// Forced class (N, S or V), or kUnknown for the automatic rule above.
+  core::CellClass forced_class = core::CellClass::kUnknown;
+  Material material = Material::kVehicle;
+  std::vector<Point2> path;
+  MotionParams motion;
+};
+
+/// The ego vehicle: its route and its motion along it.
+struct EgoSpec
+{
+  std::vector<Point2> route;
+  MotionParams motion;
+};
+
+/// Differences between the real world and the map.
+struct MapErrors
+{
+  std::vector<WorldBuilding> unmapped;     ///< real buildings that the map lacks (ground truth N)
+  std::vector<Point2> absent_at;           ///< mapped buildings, found by a point inside, that are not there
+  std::vector<std::string> absent_ids;     ///< mapped buildings, by map id, that are not there
+};
+
+/// Ground-truth raster parameters.
+struct GroundTruthParams
+{
+  double size_x = 100.0;     ///< m, window around the ego
+  double size_y = 100.0;     ///< m
+  double resolution = 0.5;   ///< m
+  double stop_speed = 0.1;   ///< m/s, a movable object slower than this is stopped (S)
+  /// Count the cells traversed by rays without any return (up to their max range) as observed.
+  bool include_no_return_rays = false;
+  /// @throws core::ParameterError naming the parameter
+  void validate() const;
+};
+
+/// A whole scenario.
+struct Scenario
+{
+  std::string name = "scenario";
+  std::string source;    ///< the YAML file it was loaded from, if any
+  std::string map_file;  ///< absolute or relative to the working directory (resolved by loadScenario)
+  /// WGS84 origin of the map frame (degrees, degrees, metres); NaN: the map loader's default (data centre).
+  double map_origin_latitude = std::numeric_limits<double>::quiet_NaN();
+  double map_origin_longitude = std::numeric_limits<double>::quiet_NaN();
+  double map_origin_altitude = 0.0;
+  double duration = 60.0;               ///< s
+  std::uint64_t seed = 1;
+  double default_building_height = 10.0;  ///< m, for map buildings without height
+  double tf_rate_hz = 100.0;              ///< map→base_link rate in the bag (≥ 50)
+  double start_stamp = 1.6e9;             ///< s, ROS time of t = 0
+  LidarParams lidar = LidarParams::fromPreset("vlp32");
+  EgoSpec ego;
+  std::vector<ObjectSpec> objects;
+  MapErrors map_errors;
+  GroundTruthParams ground_truth;
+  SceneParams scene;
+
+  /// @throws core::ParameterError naming the parameter
+  void validate() const;
+};
+
+/// The defaults (shape, size, material, mobility) of an object kind; false for an unknown kind.
+bool objectKindDefaults(const std::string& kind, ObjectSpec& spec);
+
+/**
+ * @brief Parses a scenario from YAML text. Relative file names (map) are resolved against @p base_dir.
+ * @throws core::ParameterError naming the offending key (YAML syntax errors are reported as key "yaml").
+ */
+Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir);
+
+/// Loads a scenario file (relative names in it are resolved against the file's folder).
+Scenario loadScenario(const std::string& path);
+
+}  // namespace sim
+}  // namespace map_aided_fusion

@@ -1,0 +1,269 @@
+#include "map_aided_fusion/sim/simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "map_aided_fusion/core/parameters.hpp"
+
+namespace map_aided_fusion {
+namespace sim {
+
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+constexpr double kTimeEpsilon = 1e-9;
+
+/// splitmix64: small, fast, and the same on every platform (unlike std::normal_distribution).
+class Rng
+{
+public:
+  explicit Rng(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next()
+  {
+    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  double gaussian()
+  {
+    const double u1 = 1.0 - uniform();  // (0, 1]
+    const double u2 = uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
+  }
+
+private:
+  std::uint64_t state_;
+};
+
+bool insideRing(const core::Ring& ring, core::Point2 p)
+{
+  bool inside = false;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+  {
+    const auto& a = ring[j];
+    const auto& b = ring[i];
+    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
+  }
+  return inside;
+}
+
+bool insidePolygon(const core::Polygon& poly, core::Point2 p)
+{
+  if (poly.outer.size() < 3 || !insideRing(poly.outer, p)) return false;
+  for (const auto& h : poly.holes)
+    if (h.size() >= 3 && insideRing(h, p)) return false;
+  return true;
+}
+
+}  // namespace
+
+Simulator::Simulator(Scenario scenario, const core::VectorMap& map) : scenario_(std::move(scenario))
+{
+  scenario_.validate();
+  const MapErrors& errors = scenario_.map_errors;
+  std::vector<bool> absent_point_used(errors.absent_at.size(), false);
+  std::vector<bool> absent_id_used(errors.absent_ids.size(), false);
+  std::vector<WorldBuilding> world;
+  for (const core::Building& b : map.buildings)
+  {
+    bool absent = false;
+    for (std::size_t i = 0; i < errors.absent_at.size(); ++i)
+      if (insidePolygon(b.footprint, errors.absent_at[i]))
+      {
+        absent = true;
+        absent_point_used[i] = true;
+      }
+    for (std::size_t i = 0; i < errors.absent_ids.size(); ++i)
+      if (!b.id.empty() && b.id == errors.absent_ids[i])
+      {
+        absent = true;
+        absent_id_used[i] = true;
+      }
+    if (absent)
+    {
+      ++summary_.absent_buildings;
+      continue;
+    }
+    WorldBuilding w;
+    w.footprint = b.footprint;
+    w.height = b.height > 0.0 ? b.height : scenario_.default_building_height;
+    w.cell_class = core::CellClass::kBuilding;
+    w.id = b.id;
+    world.push_back(std::move(w));
+    ++summary_.mapped_buildings;
+  }
+  for (std::size_t i = 0; i < absent_point_used.size(); ++i)
+    if (!absent_point_used[i])
+      throw core::ParameterError("map_errors.absent_buildings",
+                                 "no map building contains (" + std::to_string(errors.absent_at[i].x) + ", " +
+                                     std::to_string(errors.absent_at[i].y) + ")");
+  for (std::size_t i = 0; i < absent_id_used.size(); ++i)
+    if (!absent_id_used[i])
+      throw core::ParameterError("map_errors.absent_buildings", "no map building has id '" + errors.absent_ids[i] + "'");
+  for (WorldBuilding w : errors.unmapped)
+  {
+    w.cell_class = core::CellClass::kInfrastructure;
+    world.push_back(std::move(w));
+    ++summary_.unmapped_buildings;
+  }
+  static_raster_ = std::make_unique<StaticClassRaster>(world, scenario_.ground_truth.resolution);
+  scene_ = std::make_unique<Scene>(std::move(world), scenario_.scene);
+  ego_motion_ = std::make_unique<PathMotion>(scenario_.ego.route, scenario_.ego.motion);
+  object_motion_.reserve(scenario_.objects.size());
+  for (const ObjectSpec& o : scenario_.objects) object_motion_.emplace_back(o.path, o.motion);
+
+  const LidarParams& lidar = scenario_.lidar;
+  for (double e : lidar.elevations_deg)
+  {
+    const double rad = e * kDegToRad;
+    cos_e_.push_back(std::cos(rad));
+    sin_e_.push_back(std::sin(rad));
+    slopes_.push_back(std::tan(rad));
+    max_s_.push_back(lidar.max_range * std::cos(rad));
+  }
+  hits_.resize(slopes_.size());
+}
+
+Simulator::~Simulator() = default;
+
+int Simulator::numScans() const
+{
+  return static_cast<int>(std::floor(scenario_.duration * scenario_.lidar.rate_hz + kTimeEpsilon));
+}
+
+double Simulator::scanTime(int k) const { return k / scenario_.lidar.rate_hz; }
+
+Pose2 Simulator::egoPose(double t) const
+{
+  const MotionState st = ego_motion_->at(t);
+  return Pose2{ st.x, st.y, st.yaw };
+}
+
+double Simulator::egoSpeed(double t) const { return ego_motion_->at(t).speed; }
+
+Pose2 Simulator::lidarPose(const Pose2& ego) const
+{
+  const LidarParams& l = scenario_.lidar;
+  const double c = std::cos(ego.yaw), s = std::sin(ego.yaw);
+  return Pose2{ ego.x + c * l.mount_x - s * l.mount_y, ego.y + s * l.mount_x + c * l.mount_y,
+                ego.yaw + l.mount_yaw_deg * kDegToRad };
+}
+
+void Simulator::objectsAt(double t, std::vector<WorldObject>& solids, std::vector<ObjectTruth>& truth) const
+{
+  solids.clear();
+  truth.clear();
+  for (std::size_t i = 0; i < scenario_.objects.size(); ++i)
+  {
+    const ObjectSpec& spec = scenario_.objects[i];
+    const MotionState st = object_motion_[i].at(t);
+    if (!st.present) continue;
+    const double yaw = spec.path.size() == 1 ? spec.yaw_deg * kDegToRad : st.yaw;
+    core::CellClass cls = core::CellClass::kInfrastructure;
+    if (spec.forced_class != core::CellClass::kUnknown) cls = spec.forced_class;
+    else if (spec.movable)
+      cls = st.speed > scenario_.ground_truth.stop_speed ? core::CellClass::kMoving : core::CellClass::kStopped;
+    WorldObject w;
+    w.shape = spec.shape;
+    w.cell_class = cls;
+    w.material = spec.material;
+    w.id = spec.id;
+    ObjectTruth o;
+    o.id = spec.id;
+    o.cell_class = cls;
+    o.kind = spec.kind;
+    o.x = st.x;
+    o.y = st.y;
+    o.z = spec.z_min + 0.5 * spec.height;
+    o.yaw = yaw;
+    o.height = spec.height;
+    o.vx = st.speed * std::cos(yaw);
+    o.vy = st.speed * std::sin(yaw);
+    if (spec.shape == WorldObject::Shape::kBox)
+    {
+      w.box = OrientedBox{ st.x, st.y, yaw, spec.length, spec.width, spec.z_min, spec.z_min + spec.height };
+      o.length = spec.length;
+      o.width = spec.width;
+    }
+    else
+    {
+      w.cylinder = Cylinder{ st.x, st.y, spec.radius, spec.z_min, spec.z_min + spec.height };
+      o.length = o.width = 2.0 * spec.radius;
+    }
+    solids.push_back(w);
+    truth.push_back(std::move(o));
+  }
+}
+
+void Simulator::scan(int k, ScanFrame& out)
+{
+  const LidarParams& lidar = scenario_.lidar;
+  const GroundTruthParams& gt = scenario_.ground_truth;
+  out.index = k;
+  out.time = scanTime(k);
+  out.ego = egoPose(out.time);
+  out.lidar = lidarPose(out.ego);
+  out.points.clear();
+  out.rays = out.no_return = out.dropped = 0;
+  objectsAt(out.time, solids_, out.objects);
+  scene_->setObjects(solids_);
+
+  out.truth_geometry = static_raster_->window(out.ego.x, out.ego.y, gt.size_x, gt.size_y);
+  static_raster_->classes(out.truth_geometry, scene_->objects(), out.truth_classes);
+  observed_.assign(out.truth_geometry.numCells(), 0);
+
+  Rng rng(scenario_.seed * 0x9E3779B97F4A7C15ULL ^ (static_cast<std::uint64_t>(k) + 1) * 0xD1B54A32D192ED03ULL);
+  const int beams = lidar.numBeams();
+  const int azimuths = lidar.numAzimuths();
+  const double oz = lidar.mount_z;
+  for (int i = 0; i < azimuths; ++i)
+  {
+    const double az_l = lidar.azimuthDeg(i) * kDegToRad;
+    const double az_w = out.lidar.yaw + az_l;
+    scene_->castFan(out.lidar.x, out.lidar.y, oz, az_w, slopes_.data(), max_s_.data(), beams, hits_.data());
+    const double ca = std::cos(az_l), sa = std::sin(az_l);
+    double s_obs = -1.0;
+    for (int b = 0; b < beams; ++b)
+    {
+      ++out.rays;
+      const BeamHit& h = hits_[b];
+      if (h.solid == BeamHit::kNone)
+      {
+        ++out.no_return;
+        if (gt.include_no_return_rays) s_obs = std::max(s_obs, max_s_[b]);
+        continue;
+      }
+      s_obs = std::max(s_obs, h.s);
+      if (rng.uniform() < lidar.dropout_probability)
+      {
+        ++out.dropped;
+        continue;
+      }
+      const double r = h.s / cos_e_[b] + lidar.range_noise_stddev * rng.gaussian();
+      if (r < lidar.min_range || r > lidar.max_range)
+      {
+        ++out.dropped;
+        continue;
+      }
+      const double horizontal = r * cos_e_[b];
+      LidarPoint p;
+      p.x = static_cast<float>(horizontal * ca);
+      p.y = static_cast<float>(horizontal * sa);
+      p.z = static_cast<float>(r * sin_e_[b]);
+      p.intensity = materialIntensity(scene_->materialOf(h.solid));
+      p.ring = static_cast<std::uint16_t>(b);
+      out.points.push_back(p);
+    }
+    if (s_obs >= 0.0)
+      traverseCells(out.truth_geometry, core::Point2{ out.lidar.x, out.lidar.y }, std::cos(az_w), std::sin(az_w),
+                    s_obs, [&](std::size_t c) { observed_[c] = 1; });
+  }
+  for (std::size_t c = 0; c < observed_.size(); ++c)
+    if (!observed_[c]) out.truth_classes[c] = static_cast<std::int8_t>(core::CellClass::kUnknown);
+}
+
+}  // namespace sim
+}  // namespace map_aided_fusion
