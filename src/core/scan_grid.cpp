@@ -158,7 +158,7 @@ void ScanGridBuilder::buildTable()
   sector_scale_ = static_cast<float>(num_sectors_) / kTwoPi;
   const std::size_t n = geometry_.numCells();
   cell_sector_.resize(n);
-  cell_range_.resize(n);
+  cell_range2_.resize(n);
   cell_free_.resize(n);
   table_sensor_x_ = sensor_pose_.translation().x();
   table_sensor_y_ = sensor_pose_.translation().y();
@@ -174,12 +174,12 @@ void ScanGridBuilder::buildTable()
       const double dy = c.y - sy;
       const double r = std::hypot(dx, dy);
       cell_sector_[i] = static_cast<std::uint16_t>(sectorOf(dx, dy));
-      cell_range_[i] = r < params_.min_range ? kInfinity : static_cast<float>(r);
+      cell_range2_[i] = r < params_.min_range ? kInfinity : static_cast<float>(r * r);
       cell_free_[i] = static_cast<float>(decay ? params_.mu_free * std::exp(-r / params_.free_decay_length)
                                                : params_.mu_free);
     }
-  sector_obstacle_.assign(static_cast<std::size_t>(num_sectors_), kInfinity);
-  sector_free_.assign(static_cast<std::size_t>(num_sectors_), 0.0f);
+  sector_obstacle2_.assign(static_cast<std::size_t>(num_sectors_), kInfinity);
+  sector_free2_.assign(static_cast<std::size_t>(num_sectors_), 0.0f);
   ++table_builds_;
 }
 
@@ -194,10 +194,15 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   }
   if (grid.geometry() != geometry_ || grid.stride() == 0) grid.reset(geometry_);
 
-  std::fill(sector_obstacle_.begin(), sector_obstacle_.end(), kInfinity);
-  ground_hits_.clear();
-  ground_range_.clear();
-  occupied_cells_.clear();
+  const std::size_t n_points = points.size();
+  if (ground_sector_.size() < n_points + 1)
+  {
+    ground_sector_.resize(n_points + 1);
+    ground_range2_.resize(n_points + 1);
+    obstacle_sector_.resize(n_points + 1);
+    obstacle_range2_.resize(n_points + 1);
+    obstacle_cell_.resize(n_points + 1);
+  }
 
   const Eigen::Matrix3f rot = sensor_pose_.rotation().cast<float>();
   // Points relative to the table's sensor position (within kSensorMoveTolerance of the current one).
@@ -216,8 +221,13 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float cx0 = static_cast<float>((table_sensor_x_ - geometry_.origin_x) / geometry_.resolution);
   const float cy0 = static_cast<float>((table_sensor_y_ - geometry_.origin_y) / geometry_.resolution);
   const int width = geometry_.width;
-  const int height = geometry_.height;
+  const float fwidth = static_cast<float>(geometry_.width);
+  const float fheight = static_cast<float>(geometry_.height);
+  constexpr std::uint32_t kOutside = std::numeric_limits<std::uint32_t>::max();
 
+  // Pass 1: classify every point and compact the ground and obstacle returns.
+  std::size_t n_ground = 0, n_obstacle = 0;
+  std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, below_ground = 0, gap = 0, above = 0;
   for (std::size_t row = 0; row < points.height; ++row)
   {
     const std::uint8_t* p = points.data + row * points.row_step;
@@ -226,14 +236,14 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       const float px = readFloat(p + points.x_offset);
       const float py = readFloat(p + points.y_offset);
       const float pz = readFloat(p + points.z_offset);
-      if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz))
+      if (!(std::isfinite(px) && std::isfinite(py) && std::isfinite(pz)))
       {
-        ++st.non_finite;
+        ++non_finite;
         continue;
       }
       if (px == 0.0f && py == 0.0f && pz == 0.0f)
       {
-        ++st.no_return;
+        ++no_return;
         continue;
       }
       const float dx = rot(0, 0) * px + rot(0, 1) * py + rot(0, 2) * pz + shift_x;
@@ -242,55 +252,67 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       const float r2 = dx * dx + dy * dy;
       if (r2 < min2)
       {
-        ++st.below_min_range;
+        ++below_min;
         continue;
       }
       if (r2 > max2)
       {
-        ++st.beyond_max_range;
+        ++beyond_max;
         continue;
       }
       if (z < ground_lo)
       {
-        ++st.below_ground;
+        ++below_ground;
       }
       else if (z <= ground_hi)
       {
-        ++st.ground;
-        ground_hits_.push_back(static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_)));
-        ground_range_.push_back(std::sqrt(r2));
+        ground_sector_[n_ground] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_));
+        ground_range2_[n_ground] = r2;
+        ++n_ground;
       }
       else if (z < obstacle_lo)
       {
-        ++st.height_gap;
+        ++gap;
       }
       else if (z <= obstacle_hi)
       {
-        ++st.obstacle;
-        const int s = sectorIndex(dx, dy, sector_scale_, num_sectors_);
-        float& nearest = sector_obstacle_[static_cast<std::size_t>(s)];
-        nearest = std::min(nearest, std::sqrt(r2));
         const float fx = cx0 + dx * inv_res;
         const float fy = cy0 + dy * inv_res;
-        if (fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(width) && fy < static_cast<float>(height))
-          occupied_cells_.push_back(static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)));
-        else
-          ++st.obstacle_outside_grid;
+        const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
+        obstacle_sector_[n_obstacle] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_));
+        obstacle_range2_[n_obstacle] = r2;
+        obstacle_cell_[n_obstacle] =
+            inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
+        ++n_obstacle;
       }
       else
       {
-        ++st.above_clearance;
+        ++above;
       }
     }
   }
+  st.non_finite = non_finite;
+  st.no_return = no_return;
+  st.below_min_range = below_min;
+  st.beyond_max_range = beyond_max;
+  st.below_ground = below_ground;
+  st.height_gap = gap;
+  st.above_clearance = above;
+  st.ground = n_ground;
+  st.obstacle = n_obstacle;
 
-  for (std::size_t s = 0; s < sector_free_.size(); ++s)
-    sector_free_[s] = std::isinf(sector_obstacle_[s]) ? 0.0f : sector_obstacle_[s];
-  for (std::size_t k = 0; k < ground_hits_.size(); ++k)
+  // Pass 2: per sector, the nearest obstacle; the free limit is it or the farthest ground return before it.
+  float* const obstacle2 = sector_obstacle2_.data();
+  float* const free2 = sector_free2_.data();
+  std::fill(sector_obstacle2_.begin(), sector_obstacle2_.end(), kInfinity);
+  for (std::size_t k = 0; k < n_obstacle; ++k)
+    obstacle2[obstacle_sector_[k]] = std::min(obstacle2[obstacle_sector_[k]], obstacle_range2_[k]);
+  for (std::size_t s = 0; s < sector_free2_.size(); ++s) free2[s] = std::isinf(obstacle2[s]) ? 0.0f : obstacle2[s];
+  for (std::size_t k = 0; k < n_ground; ++k)
   {
-    const std::size_t s = ground_hits_[k];
-    const float r = ground_range_[k];
-    if (r < sector_obstacle_[s] && r > sector_free_[s]) sector_free_[s] = r;
+    const std::uint32_t s = ground_sector_[k];
+    const float r2 = ground_range2_[k];
+    if (r2 < obstacle2[s] && r2 > free2[s]) free2[s] = r2;
   }
 
   float* const m_empty = grid.plane(FrameSG::kEmpty);
@@ -298,9 +320,9 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const m_o = grid.plane(FrameSG::kO);
   float* const m_omega = grid.plane(FrameSG::kOmega);
   const std::size_t n = geometry_.numCells();
-  const float* const limit = sector_free_.data();
+  const float* const limit = free2;
   const std::uint16_t* const sector = cell_sector_.data();
-  const float* const range = cell_range_.data();
+  const float* const range = cell_range2_.data();
   std::size_t free_cells = 0;
   if (params_.free_decay_length > 0.0)
   {
@@ -333,8 +355,10 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float mu_o = static_cast<float>(params_.mu_occupied);
   std::size_t occupied = 0;
   if (mu_o > 0.0f)
-    for (const std::uint32_t i : occupied_cells_)
+    for (std::size_t k = 0; k < n_obstacle; ++k)
     {
+      const std::uint32_t i = obstacle_cell_[k];
+      if (i == kOutside) continue;
       if (m_o[i] != 0.0f) continue;
       if (m_f[i] > 0.0f) --free_cells;
       m_f[i] = 0.0f;
@@ -342,6 +366,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       m_omega[i] = 1.0f - mu_o;
       ++occupied;
     }
+  for (std::size_t k = 0; k < n_obstacle; ++k) st.obstacle_outside_grid += obstacle_cell_[k] == kOutside;
   st.occupied_cells = occupied;
   st.free_cells = free_cells;
   if (stats) *stats = st;

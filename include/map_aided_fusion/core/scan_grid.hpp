@@ -172,17 +172,20 @@ private:
   double table_sensor_x_ = 0.0;  // sensor position the table was computed for
   double table_sensor_y_ = 0.0;
 
-  // Table, one entry per cell.
+  // Table, one entry per cell: sector, squared range from the sensor (+inf below min_range), μ_F(r).
   std::vector<std::uint16_t> cell_sector_;
-  AlignedVector<float> cell_range_;
+  AlignedVector<float> cell_range2_;
   AlignedVector<float> cell_free_;
 
-  // Scratch, reused between scans.
-  std::vector<float> sector_obstacle_;
-  std::vector<float> sector_free_;
-  std::vector<std::uint32_t> ground_hits_;  // sector of each ground return, packed with ground_range_
-  std::vector<float> ground_range_;
-  std::vector<std::uint32_t> occupied_cells_;
+  // Scratch, reused between scans: per sector the squared range of the nearest obstacle and of the free
+  // limit; the ground and obstacle returns of the scan, compacted (sector, squared range, cell).
+  std::vector<float> sector_obstacle2_;
+  std::vector<float> sector_free2_;
+  std::vector<std::uint32_t> ground_sector_;
+  std::vector<float> ground_range2_;
+  std::vector<std::uint32_t> obstacle_sector_;
+  std::vector<float> obstacle_range2_;
+  std::vector<std::uint32_t> obstacle_cell_;
 };
 
 }  // namespace core
