@@ -156,30 +156,41 @@ void ScanGridBuilder::buildTable()
 {
   num_sectors_ = static_cast<int>(std::ceil(kFullTurnDeg / params_.azimuth_resolution_deg - 1e-9));
   sector_scale_ = static_cast<float>(num_sectors_) / kTwoPi;
-  const std::size_t n = geometry_.numCells();
-  cell_sector_.resize(n);
-  cell_range2_.resize(n);
-  cell_free_.resize(n);
   table_sensor_x_ = sensor_pose_.translation().x();
   table_sensor_y_ = sensor_pose_.translation().y();
-  const double sx = table_sensor_x_;
-  const double sy = table_sensor_y_;
   const bool decay = params_.free_decay_length > 0.0;
+  const std::size_t sectors = static_cast<std::size_t>(num_sectors_);
+
+  std::vector<TableEntry> entries;
+  std::vector<std::uint32_t> entry_sector;
+  entries.reserve(geometry_.numCells());
+  entry_sector.reserve(geometry_.numCells());
   for (int y = 0; y < geometry_.height; ++y)
     for (int x = 0; x < geometry_.width; ++x)
     {
-      const std::size_t i = geometry_.index(x, y);
       const Point2 c = geometry_.cellCentre(CellIndex{ x, y });
-      const double dx = c.x - sx;
-      const double dy = c.y - sy;
+      const double dx = c.x - table_sensor_x_;
+      const double dy = c.y - table_sensor_y_;
       const double r = std::hypot(dx, dy);
-      cell_sector_[i] = static_cast<std::uint16_t>(sectorOf(dx, dy));
-      cell_range2_[i] = r < params_.min_range ? kInfinity : static_cast<float>(r * r);
-      cell_free_[i] = static_cast<float>(decay ? params_.mu_free * std::exp(-r / params_.free_decay_length)
-                                               : params_.mu_free);
+      if (r < params_.min_range || r > params_.max_range) continue;  // never free
+      const double mu = decay ? params_.mu_free * std::exp(-r / params_.free_decay_length) : params_.mu_free;
+      entries.push_back({ static_cast<float>(r * r), static_cast<std::uint32_t>(geometry_.index(x, y)),
+                          static_cast<float>(mu) });
+      entry_sector.push_back(static_cast<std::uint32_t>(sectorOf(dx, dy)));
     }
-  sector_obstacle2_.assign(static_cast<std::size_t>(num_sectors_), kInfinity);
-  sector_free2_.assign(static_cast<std::size_t>(num_sectors_), 0.0f);
+
+  sector_begin_.assign(sectors + 1, 0);
+  for (const std::uint32_t s : entry_sector) ++sector_begin_[s + 1];
+  for (std::size_t s = 0; s < sectors; ++s) sector_begin_[s + 1] += sector_begin_[s];
+  table_.resize(entries.size());
+  std::vector<std::uint32_t> next(sector_begin_.begin(), sector_begin_.end() - 1);
+  for (std::size_t k = 0; k < entries.size(); ++k) table_[next[entry_sector[k]]++] = entries[k];
+  for (std::size_t s = 0; s < sectors; ++s)
+    std::sort(table_.begin() + sector_begin_[s], table_.begin() + sector_begin_[s + 1],
+              [](const TableEntry& a, const TableEntry& b) { return a.range2 < b.range2; });
+
+  sector_obstacle2_.assign(sectors, kInfinity);
+  sector_free2_.assign(sectors, 0.0f);
   ++table_builds_;
 }
 
@@ -320,37 +331,24 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const m_o = grid.plane(FrameSG::kO);
   float* const m_omega = grid.plane(FrameSG::kOmega);
   const std::size_t n = geometry_.numCells();
-  const float* const limit = free2;
-  const std::uint16_t* const sector = cell_sector_.data();
-  const float* const range = cell_range2_.data();
+  std::fill_n(m_empty, n, 0.0f);
+  std::fill_n(m_f, n, 0.0f);
+  std::fill_n(m_o, n, 0.0f);
+  std::fill_n(m_omega, n, 1.0f);
   std::size_t free_cells = 0;
-  if (params_.free_decay_length > 0.0)
+  const TableEntry* const table = table_.data();
+  for (std::size_t s = 0; s < sector_free2_.size(); ++s)
   {
-    const float* const mu = cell_free_.data();
-    for (std::size_t i = 0; i < n; ++i)
+    const float limit = free2[s];
+    const std::uint32_t end = sector_begin_[s + 1];
+    for (std::uint32_t k = sector_begin_[s]; k < end && table[k].range2 < limit; ++k)
     {
-      const float f = mu[i] * static_cast<float>(range[i] < limit[sector[i]]);
-      m_f[i] = f;
-      m_o[i] = 0.0f;
-      m_omega[i] = 1.0f - f;
+      const float f = table[k].mu_free;
+      m_f[table[k].cell] = f;
+      m_omega[table[k].cell] = 1.0f - f;
       free_cells += f > 0.0f;
     }
   }
-  else
-  {
-    const float mu = static_cast<float>(params_.mu_free);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      const bool is_free = range[i] < limit[sector[i]];
-      const float f = mu * static_cast<float>(is_free);
-      m_f[i] = f;
-      m_o[i] = 0.0f;
-      m_omega[i] = 1.0f - f;
-      free_cells += is_free;
-    }
-    if (mu <= 0.0f) free_cells = 0;
-  }
-  std::fill_n(m_empty, n, 0.0f);
 
   const float mu_o = static_cast<float>(params_.mu_occupied);
   std::size_t occupied = 0;

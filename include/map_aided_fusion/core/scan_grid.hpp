@@ -16,7 +16,8 @@
  *   [min_range, max_range]) are never obstacles and are counted in ScanGridStats.
  *
  * The Cartesian grid samples the polar model at each cell centre; the cell → (sector, range, μ_F(r))
- * table is computed once per (parameters, geometry, sensor position), not per scan.
+ * table is computed once per (parameters, geometry, sensor position), not per scan. It lists the cells of
+ * each sector by increasing range, so a scan only writes its free cells after resetting the planes.
  * ROS-free: Eigen and the standard library only.
  */
 #pragma once
@@ -172,10 +173,17 @@ private:
   double table_sensor_x_ = 0.0;  // sensor position the table was computed for
   double table_sensor_y_ = 0.0;
 
-  // Table, one entry per cell: sector, squared range from the sensor (+inf below min_range), μ_F(r).
-  std::vector<std::uint16_t> cell_sector_;
-  AlignedVector<float> cell_range2_;
-  AlignedVector<float> cell_free_;
+  /// A cell of the table: squared range from the sensor, index, μ_F(r).
+  struct TableEntry
+  {
+    float range2;
+    std::uint32_t cell;
+    float mu_free;
+  };
+  // Table: the cells in [min_range, max_range] grouped by sector, each group sorted by range, so that
+  // the free cells of a sector are a prefix of its group.
+  std::vector<TableEntry> table_;
+  std::vector<std::uint32_t> sector_begin_;  // group of sector s: [sector_begin_[s], sector_begin_[s + 1])
 
   // Scratch, reused between scans: per sector the squared range of the nearest obstacle and of the free
   // limit; the ground and obstacle returns of the scan, compacted (sector, squared range, cell).
