@@ -72,6 +72,11 @@ void ScanGridParams::validate() const
   requireInRange("min_range", min_range, 0.0, std::numeric_limits<double>::max());
   requirePositive("max_range", max_range);
   if (!(max_range > min_range)) throw ParameterError("max_range", "must be > min_range");
+  const double big = std::numeric_limits<double>::max();
+  requireInRange("self_box_min_x", self_box_min_x, -big, big);
+  requireInRange("self_box_max_x", self_box_max_x, self_box_min_x, big);
+  requireInRange("self_box_min_y", self_box_min_y, -big, big);
+  requireInRange("self_box_max_y", self_box_max_y, self_box_min_y, big);
   requireInRange("ground_height", ground_height, -std::numeric_limits<double>::max(),
                  std::numeric_limits<double>::max());
   requireInRange("ground_tolerance", ground_tolerance, 0.0, std::numeric_limits<double>::max());
@@ -238,7 +243,13 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
 
   // Pass 1: classify every point and compact the ground and obstacle returns.
   std::size_t n_ground = 0, n_obstacle = 0;
-  std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, below_ground = 0, gap = 0, above = 0;
+  std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, self = 0;
+  std::size_t below_ground = 0, gap = 0, above = 0;
+  // Self box relative to the table's sensor position.
+  const float self_min_x = static_cast<float>(params_.self_box_min_x - table_sensor_x_);
+  const float self_max_x = static_cast<float>(params_.self_box_max_x - table_sensor_x_);
+  const float self_min_y = static_cast<float>(params_.self_box_min_y - table_sensor_y_);
+  const float self_max_y = static_cast<float>(params_.self_box_max_y - table_sensor_y_);
   for (std::size_t row = 0; row < points.height; ++row)
   {
     const std::uint8_t* p = points.data + row * points.row_step;
@@ -269,6 +280,11 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       if (r2 > max2)
       {
         ++beyond_max;
+        continue;
+      }
+      if (dx > self_min_x && dx < self_max_x && dy > self_min_y && dy < self_max_y)
+      {
+        ++self;
         continue;
       }
       if (z < ground_lo)
@@ -306,6 +322,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   st.no_return = no_return;
   st.below_min_range = below_min;
   st.beyond_max_range = beyond_max;
+  st.self_returns = self;
   st.below_ground = below_ground;
   st.height_gap = gap;
   st.above_clearance = above;

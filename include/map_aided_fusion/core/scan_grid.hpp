@@ -13,7 +13,8 @@
  * - returns above the clearance height (canopies, bridges), below the ground band, or in the gap
  *   between the ground band and the obstacle band are neither;
  * - invalid returns (NaN/inf, the (0, 0, 0) "no return" point, horizontal range outside
- *   [min_range, max_range]) are never obstacles and are counted in ScanGridStats.
+ *   [min_range, max_range], returns from the vehicle's own body inside the self-filter box) are never
+ *   obstacles and are counted in ScanGridStats.
  *
  * The Cartesian grid samples the polar model at each cell centre; the cell → (sector, range, μ_F(r))
  * table is computed once per (parameters, geometry, sensor position), not per scan. It lists the cells of
@@ -48,6 +49,13 @@ struct ScanGridParams
   double azimuth_resolution_deg = 0.25;  ///< width of an azimuth sector, degrees, in [0.01, 45]
   double min_range = 1.0;                ///< horizontal range below which a return is rejected, m (≥ 0)
   double max_range = 80.0;               ///< horizontal range beyond which a return is rejected, m (> min_range)
+
+  // Self filter: returns strictly inside this base_link box (the vehicle's own body) are rejected.
+  // The default empty box disables it.
+  double self_box_min_x = 0.0;  ///< m
+  double self_box_max_x = 0.0;  ///< m (≥ self_box_min_x)
+  double self_box_min_y = 0.0;  ///< m
+  double self_box_max_y = 0.0;  ///< m (≥ self_box_min_y)
 
   // Heights in base_link.
   double ground_height = 0.0;        ///< z of the ground surface in base_link, m
@@ -107,6 +115,7 @@ struct ScanGridStats
   std::size_t no_return = 0;            ///< exactly (0, 0, 0) in the sensor frame
   std::size_t below_min_range = 0;      ///< horizontal range < min_range
   std::size_t beyond_max_range = 0;     ///< horizontal range > max_range
+  std::size_t self_returns = 0;         ///< inside the self-filter box (the vehicle's body)
   std::size_t ground = 0;               ///< ground returns
   std::size_t obstacle = 0;             ///< obstacle returns
   std::size_t obstacle_outside_grid = 0;///< obstacle returns outside the grid (still bound free space)
@@ -116,7 +125,7 @@ struct ScanGridStats
   std::size_t occupied_cells = 0;       ///< cells with m(O) = μ_O
   std::size_t free_cells = 0;           ///< cells with m(F) > 0
 
-  std::size_t rejected() const { return non_finite + no_return + below_min_range + beyond_max_range; }
+  std::size_t rejected() const { return non_finite + no_return + below_min_range + beyond_max_range + self_returns; }
 };
 
 /**
