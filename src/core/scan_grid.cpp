@@ -15,6 +15,7 @@ namespace {
 constexpr double kFullTurnDeg = 360.0;
 constexpr double kMinAzimuthResolutionDeg = 0.01;
 constexpr double kMaxAzimuthResolutionDeg = 45.0;
+constexpr double kSectorCountSlack = 1e-9;     // 360 / 0.25 is 1440 sectors, not 1441
 constexpr double kSensorMoveTolerance = 1e-3;  // m; a smaller (x, y) change keeps the table
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kHalfPi = 0.5f * kPi;
@@ -159,7 +160,7 @@ int ScanGridBuilder::sectorOf(double dx, double dy) const
 
 void ScanGridBuilder::buildTable()
 {
-  num_sectors_ = static_cast<int>(std::ceil(kFullTurnDeg / params_.azimuth_resolution_deg - 1e-9));
+  num_sectors_ = static_cast<int>(std::ceil(kFullTurnDeg / params_.azimuth_resolution_deg - kSectorCountSlack));
   sector_scale_ = static_cast<float>(num_sectors_) / kTwoPi;
   table_sensor_x_ = sensor_pose_.translation().x();
   table_sensor_y_ = sensor_pose_.translation().y();

@@ -189,8 +189,9 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   Eigen::Isometry3d pose;
   try
   {
-    pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, cloud->header.frame_id, cloud->header.stamp)
-                       .transform);
+    const std::string& frame = cloud->header.frame_id;
+    const std::string source = frame.empty() || frame[0] != '/' ? frame : frame.substr(1);  // tf1-style "/lidar"
+    pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, source, cloud->header.stamp).transform);
     builder_.setSensorPose(pose);
   }
   catch (const tf2::TransformException& e)

@@ -220,6 +220,14 @@ TEST(ScanGridNodelet, PublishesGridsWithTheCloudStampAndSurvivesMalformedClouds)
   EXPECT_TRUE(waitFor([&] { return probe.occupancy(t4); }));
   // 4. Both are counted.
   EXPECT_TRUE(waitFor([&] { return probe.rejected() == 2; })) << "clouds rejected = " << probe.rejected();
+  // 5. A tf1-style frame id ("/lidar") is accepted.
+  const ros::Time t5(1004, 0);
+  auto slashed = wallCloud(t5);
+  slashed->header.frame_id = "/lidar";
+  probe.publish(slashed);
+  const bool got_t5 = waitFor([&] { return probe.grid(t5) != nullptr; });
+  ASSERT_TRUE(got_t5) << "no grid for a cloud in frame /lidar";
+  checkWallGrid(*probe.grid(t5));
 }
 
 TEST(ScanGridNode, PlainNodeRunsTheSameWorker)
