@@ -241,6 +241,17 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float fwidth = static_cast<float>(geometry_.width);
   const float fheight = static_cast<float>(geometry_.height);
   constexpr std::uint32_t kOutside = std::numeric_limits<std::uint32_t>::max();
+  const float sector_scale = sector_scale_;
+  const int num_sectors = num_sectors_;
+  std::uint32_t* const ground_sector = ground_sector_.data();
+  float* const ground_range2 = ground_range2_.data();
+  std::uint32_t* const obstacle_sector = obstacle_sector_.data();
+  float* const obstacle_range2 = obstacle_range2_.data();
+  std::uint32_t* const obstacle_cell = obstacle_cell_.data();
+  const std::uint8_t* const data = points.data;
+  const std::size_t rows = points.height, cols = points.width, point_step = points.point_step;
+  const std::size_t row_step = points.row_step;
+  const std::size_t x_offset = points.x_offset, y_offset = points.y_offset, z_offset = points.z_offset;
 
   // Pass 1: classify every point and compact the ground and obstacle returns.
   std::size_t n_ground = 0, n_obstacle = 0;
@@ -251,14 +262,14 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float self_max_x = static_cast<float>(params_.self_box_max_x - table_sensor_x_);
   const float self_min_y = static_cast<float>(params_.self_box_min_y - table_sensor_y_);
   const float self_max_y = static_cast<float>(params_.self_box_max_y - table_sensor_y_);
-  for (std::size_t row = 0; row < points.height; ++row)
+  for (std::size_t row = 0; row < rows; ++row)
   {
-    const std::uint8_t* p = points.data + row * points.row_step;
-    for (std::size_t col = 0; col < points.width; ++col, p += points.point_step)
+    const std::uint8_t* p = data + row * row_step;
+    for (std::size_t col = 0; col < cols; ++col, p += point_step)
     {
-      const float px = readFloat(p + points.x_offset);
-      const float py = readFloat(p + points.y_offset);
-      const float pz = readFloat(p + points.z_offset);
+      const float px = readFloat(p + x_offset);
+      const float py = readFloat(p + y_offset);
+      const float pz = readFloat(p + z_offset);
       if (!(std::isfinite(px) && std::isfinite(py) && std::isfinite(pz)))
       {
         ++non_finite;
@@ -294,8 +305,8 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       }
       else if (z <= ground_hi)
       {
-        ground_sector_[n_ground] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_));
-        ground_range2_[n_ground] = r2;
+        ground_sector[n_ground] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+        ground_range2[n_ground] = r2;
         ++n_ground;
       }
       else if (z < obstacle_lo)
@@ -307,9 +318,9 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         const float fx = cx0 + dx * inv_res;
         const float fy = cy0 + dy * inv_res;
         const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
-        obstacle_sector_[n_obstacle] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_));
-        obstacle_range2_[n_obstacle] = r2;
-        obstacle_cell_[n_obstacle] =
+        obstacle_sector[n_obstacle] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+        obstacle_range2[n_obstacle] = r2;
+        obstacle_cell[n_obstacle] =
             inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
         ++n_obstacle;
       }
