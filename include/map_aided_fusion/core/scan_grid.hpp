@@ -16,6 +16,10 @@
  *   [min_range, max_range], returns from the vehicle's own body inside the self-filter box) are never
  *   obstacles and are counted in ScanGridStats.
  *
+ * Sectors tile the full turn from azimuth −180° (base_link axes), ceil(360 / azimuth_resolution_deg) of
+ * them. Cells closer to the sensor than min_range are never free (the sensor cannot see there); a cell
+ * holding an obstacle return is occupied even when the polar model calls it free.
+ *
  * The Cartesian grid samples the polar model at each cell centre; the cell → (sector, range, μ_F(r))
  * table is computed once per (parameters, geometry, sensor position), not per scan. It lists the cells of
  * each sector by increasing range, so a scan only writes its free cells after resetting the planes.
