@@ -15,6 +15,7 @@ namespace {
 constexpr double kFullTurnDeg = 360.0;
 constexpr double kMinAzimuthResolutionDeg = 0.01;
 constexpr double kMaxAzimuthResolutionDeg = 45.0;
+constexpr double kSectorCountSlack = 1e-9;     // 360 / 0.25 is 1440 sectors, not 1441
 constexpr double kSensorMoveTolerance = 1e-3;  // m; a smaller (x, y) change keeps the table
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kHalfPi = 0.5f * kPi;
@@ -72,6 +73,11 @@ void ScanGridParams::validate() const
   requireInRange("min_range", min_range, 0.0, std::numeric_limits<double>::max());
   requirePositive("max_range", max_range);
   if (!(max_range > min_range)) throw ParameterError("max_range", "must be > min_range");
+  const double big = std::numeric_limits<double>::max();
+  requireInRange("self_box_min_x", self_box_min_x, -big, big);
+  requireInRange("self_box_max_x", self_box_max_x, self_box_min_x, big);
+  requireInRange("self_box_min_y", self_box_min_y, -big, big);
+  requireInRange("self_box_max_y", self_box_max_y, self_box_min_y, big);
   requireInRange("ground_height", ground_height, -std::numeric_limits<double>::max(),
                  std::numeric_limits<double>::max());
   requireInRange("ground_tolerance", ground_tolerance, 0.0, std::numeric_limits<double>::max());
@@ -154,32 +160,43 @@ int ScanGridBuilder::sectorOf(double dx, double dy) const
 
 void ScanGridBuilder::buildTable()
 {
-  num_sectors_ = static_cast<int>(std::ceil(kFullTurnDeg / params_.azimuth_resolution_deg - 1e-9));
+  num_sectors_ = static_cast<int>(std::ceil(kFullTurnDeg / params_.azimuth_resolution_deg - kSectorCountSlack));
   sector_scale_ = static_cast<float>(num_sectors_) / kTwoPi;
-  const std::size_t n = geometry_.numCells();
-  cell_sector_.resize(n);
-  cell_range_.resize(n);
-  cell_free_.resize(n);
   table_sensor_x_ = sensor_pose_.translation().x();
   table_sensor_y_ = sensor_pose_.translation().y();
-  const double sx = table_sensor_x_;
-  const double sy = table_sensor_y_;
   const bool decay = params_.free_decay_length > 0.0;
+  const std::size_t sectors = static_cast<std::size_t>(num_sectors_);
+
+  std::vector<TableEntry> entries;
+  std::vector<std::uint32_t> entry_sector;
+  entries.reserve(geometry_.numCells());
+  entry_sector.reserve(geometry_.numCells());
   for (int y = 0; y < geometry_.height; ++y)
     for (int x = 0; x < geometry_.width; ++x)
     {
-      const std::size_t i = geometry_.index(x, y);
       const Point2 c = geometry_.cellCentre(CellIndex{ x, y });
-      const double dx = c.x - sx;
-      const double dy = c.y - sy;
+      const double dx = c.x - table_sensor_x_;
+      const double dy = c.y - table_sensor_y_;
       const double r = std::hypot(dx, dy);
-      cell_sector_[i] = static_cast<std::uint16_t>(sectorOf(dx, dy));
-      cell_range_[i] = r < params_.min_range ? kInfinity : static_cast<float>(r);
-      cell_free_[i] = static_cast<float>(decay ? params_.mu_free * std::exp(-r / params_.free_decay_length)
-                                               : params_.mu_free);
+      if (r < params_.min_range || r > params_.max_range) continue;  // never free
+      const double mu = decay ? params_.mu_free * std::exp(-r / params_.free_decay_length) : params_.mu_free;
+      entries.push_back({ static_cast<float>(r * r), static_cast<std::uint32_t>(geometry_.index(x, y)),
+                          static_cast<float>(mu) });
+      entry_sector.push_back(static_cast<std::uint32_t>(sectorOf(dx, dy)));
     }
-  sector_obstacle_.assign(static_cast<std::size_t>(num_sectors_), kInfinity);
-  sector_free_.assign(static_cast<std::size_t>(num_sectors_), 0.0f);
+
+  sector_begin_.assign(sectors + 1, 0);
+  for (const std::uint32_t s : entry_sector) ++sector_begin_[s + 1];
+  for (std::size_t s = 0; s < sectors; ++s) sector_begin_[s + 1] += sector_begin_[s];
+  table_.resize(entries.size());
+  std::vector<std::uint32_t> next(sector_begin_.begin(), sector_begin_.end() - 1);
+  for (std::size_t k = 0; k < entries.size(); ++k) table_[next[entry_sector[k]]++] = entries[k];
+  for (std::size_t s = 0; s < sectors; ++s)
+    std::sort(table_.begin() + sector_begin_[s], table_.begin() + sector_begin_[s + 1],
+              [](const TableEntry& a, const TableEntry& b) { return a.range2 < b.range2; });
+
+  sector_obstacle2_.assign(sectors, kInfinity);
+  sector_free2_.assign(sectors, 0.0f);
   ++table_builds_;
 }
 
@@ -194,10 +211,15 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   }
   if (grid.geometry() != geometry_ || grid.stride() == 0) grid.reset(geometry_);
 
-  std::fill(sector_obstacle_.begin(), sector_obstacle_.end(), kInfinity);
-  ground_hits_.clear();
-  ground_range_.clear();
-  occupied_cells_.clear();
+  const std::size_t n_points = points.size();
+  if (ground_sector_.size() < n_points + 1)
+  {
+    ground_sector_.resize(n_points + 1);
+    ground_range2_.resize(n_points + 1);
+    obstacle_sector_.resize(n_points + 1);
+    obstacle_range2_.resize(n_points + 1);
+    obstacle_cell_.resize(n_points + 1);
+  }
 
   const Eigen::Matrix3f rot = sensor_pose_.rotation().cast<float>();
   // Points relative to the table's sensor position (within kSensorMoveTolerance of the current one).
@@ -216,24 +238,46 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float cx0 = static_cast<float>((table_sensor_x_ - geometry_.origin_x) / geometry_.resolution);
   const float cy0 = static_cast<float>((table_sensor_y_ - geometry_.origin_y) / geometry_.resolution);
   const int width = geometry_.width;
-  const int height = geometry_.height;
+  const float fwidth = static_cast<float>(geometry_.width);
+  const float fheight = static_cast<float>(geometry_.height);
+  constexpr std::uint32_t kOutside = std::numeric_limits<std::uint32_t>::max();
+  const float sector_scale = sector_scale_;
+  const int num_sectors = num_sectors_;
+  std::uint32_t* const ground_sector = ground_sector_.data();
+  float* const ground_range2 = ground_range2_.data();
+  std::uint32_t* const obstacle_sector = obstacle_sector_.data();
+  float* const obstacle_range2 = obstacle_range2_.data();
+  std::uint32_t* const obstacle_cell = obstacle_cell_.data();
+  const std::uint8_t* const data = points.data;
+  const std::size_t rows = points.height, cols = points.width, point_step = points.point_step;
+  const std::size_t row_step = points.row_step;
+  const std::size_t x_offset = points.x_offset, y_offset = points.y_offset, z_offset = points.z_offset;
 
-  for (std::size_t row = 0; row < points.height; ++row)
+  // Pass 1: classify every point and compact the ground and obstacle returns.
+  std::size_t n_ground = 0, n_obstacle = 0;
+  std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, self = 0;
+  std::size_t below_ground = 0, gap = 0, above = 0;
+  // Self box relative to the table's sensor position.
+  const float self_min_x = static_cast<float>(params_.self_box_min_x - table_sensor_x_);
+  const float self_max_x = static_cast<float>(params_.self_box_max_x - table_sensor_x_);
+  const float self_min_y = static_cast<float>(params_.self_box_min_y - table_sensor_y_);
+  const float self_max_y = static_cast<float>(params_.self_box_max_y - table_sensor_y_);
+  for (std::size_t row = 0; row < rows; ++row)
   {
-    const std::uint8_t* p = points.data + row * points.row_step;
-    for (std::size_t col = 0; col < points.width; ++col, p += points.point_step)
+    const std::uint8_t* p = data + row * row_step;
+    for (std::size_t col = 0; col < cols; ++col, p += point_step)
     {
-      const float px = readFloat(p + points.x_offset);
-      const float py = readFloat(p + points.y_offset);
-      const float pz = readFloat(p + points.z_offset);
-      if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz))
+      const float px = readFloat(p + x_offset);
+      const float py = readFloat(p + y_offset);
+      const float pz = readFloat(p + z_offset);
+      if (!(std::isfinite(px) && std::isfinite(py) && std::isfinite(pz)))
       {
-        ++st.non_finite;
+        ++non_finite;
         continue;
       }
       if (px == 0.0f && py == 0.0f && pz == 0.0f)
       {
-        ++st.no_return;
+        ++no_return;
         continue;
       }
       const float dx = rot(0, 0) * px + rot(0, 1) * py + rot(0, 2) * pz + shift_x;
@@ -242,55 +286,73 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       const float r2 = dx * dx + dy * dy;
       if (r2 < min2)
       {
-        ++st.below_min_range;
+        ++below_min;
         continue;
       }
       if (r2 > max2)
       {
-        ++st.beyond_max_range;
+        ++beyond_max;
+        continue;
+      }
+      if (dx > self_min_x && dx < self_max_x && dy > self_min_y && dy < self_max_y)
+      {
+        ++self;
         continue;
       }
       if (z < ground_lo)
       {
-        ++st.below_ground;
+        ++below_ground;
       }
       else if (z <= ground_hi)
       {
-        ++st.ground;
-        ground_hits_.push_back(static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale_, num_sectors_)));
-        ground_range_.push_back(std::sqrt(r2));
+        ground_sector[n_ground] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+        ground_range2[n_ground] = r2;
+        ++n_ground;
       }
       else if (z < obstacle_lo)
       {
-        ++st.height_gap;
+        ++gap;
       }
       else if (z <= obstacle_hi)
       {
-        ++st.obstacle;
-        const int s = sectorIndex(dx, dy, sector_scale_, num_sectors_);
-        float& nearest = sector_obstacle_[static_cast<std::size_t>(s)];
-        nearest = std::min(nearest, std::sqrt(r2));
         const float fx = cx0 + dx * inv_res;
         const float fy = cy0 + dy * inv_res;
-        if (fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(width) && fy < static_cast<float>(height))
-          occupied_cells_.push_back(static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)));
-        else
-          ++st.obstacle_outside_grid;
+        const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
+        obstacle_sector[n_obstacle] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+        obstacle_range2[n_obstacle] = r2;
+        obstacle_cell[n_obstacle] =
+            inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
+        ++n_obstacle;
       }
       else
       {
-        ++st.above_clearance;
+        ++above;
       }
     }
   }
+  st.non_finite = non_finite;
+  st.no_return = no_return;
+  st.below_min_range = below_min;
+  st.beyond_max_range = beyond_max;
+  st.self_returns = self;
+  st.below_ground = below_ground;
+  st.height_gap = gap;
+  st.above_clearance = above;
+  st.ground = n_ground;
+  st.obstacle = n_obstacle;
 
-  for (std::size_t s = 0; s < sector_free_.size(); ++s)
-    sector_free_[s] = std::isinf(sector_obstacle_[s]) ? 0.0f : sector_obstacle_[s];
-  for (std::size_t k = 0; k < ground_hits_.size(); ++k)
+  // Pass 2: per sector, the nearest obstacle; the free limit is it or the farthest ground return before it.
+  float* const obstacle2 = sector_obstacle2_.data();
+  float* const free2 = sector_free2_.data();
+  std::fill(sector_obstacle2_.begin(), sector_obstacle2_.end(), kInfinity);
+  for (std::size_t k = 0; k < n_obstacle; ++k)
+    obstacle2[obstacle_sector_[k]] = std::min(obstacle2[obstacle_sector_[k]], obstacle_range2_[k]);
+  for (std::size_t s = 0; s < sector_free2_.size(); ++s) free2[s] = std::isinf(obstacle2[s]) ? 0.0f : obstacle2[s];
+  for (std::size_t k = 0; k < n_ground; ++k)
   {
-    const std::size_t s = ground_hits_[k];
-    const float r = ground_range_[k];
-    if (r < sector_obstacle_[s] && r > sector_free_[s]) sector_free_[s] = r;
+    const std::uint32_t s = ground_sector_[k];
+    const float r2 = ground_range2_[k];
+    if (r2 < obstacle2[s] && r2 > free2[s]) free2[s] = r2;
   }
 
   float* const m_empty = grid.plane(FrameSG::kEmpty);
@@ -298,43 +360,32 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const m_o = grid.plane(FrameSG::kO);
   float* const m_omega = grid.plane(FrameSG::kOmega);
   const std::size_t n = geometry_.numCells();
-  const float* const limit = sector_free_.data();
-  const std::uint16_t* const sector = cell_sector_.data();
-  const float* const range = cell_range_.data();
+  std::fill_n(m_empty, n, 0.0f);
+  std::fill_n(m_f, n, 0.0f);
+  std::fill_n(m_o, n, 0.0f);
+  std::fill_n(m_omega, n, 1.0f);
   std::size_t free_cells = 0;
-  if (params_.free_decay_length > 0.0)
+  const TableEntry* const table = table_.data();
+  for (std::size_t s = 0; s < sector_free2_.size(); ++s)
   {
-    const float* const mu = cell_free_.data();
-    for (std::size_t i = 0; i < n; ++i)
+    const float limit = free2[s];
+    const std::uint32_t end = sector_begin_[s + 1];
+    for (std::uint32_t k = sector_begin_[s]; k < end && table[k].range2 < limit; ++k)
     {
-      const float f = mu[i] * static_cast<float>(range[i] < limit[sector[i]]);
-      m_f[i] = f;
-      m_o[i] = 0.0f;
-      m_omega[i] = 1.0f - f;
+      const float f = table[k].mu_free;
+      m_f[table[k].cell] = f;
+      m_omega[table[k].cell] = 1.0f - f;
       free_cells += f > 0.0f;
     }
   }
-  else
-  {
-    const float mu = static_cast<float>(params_.mu_free);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      const bool is_free = range[i] < limit[sector[i]];
-      const float f = mu * static_cast<float>(is_free);
-      m_f[i] = f;
-      m_o[i] = 0.0f;
-      m_omega[i] = 1.0f - f;
-      free_cells += is_free;
-    }
-    if (mu <= 0.0f) free_cells = 0;
-  }
-  std::fill_n(m_empty, n, 0.0f);
 
   const float mu_o = static_cast<float>(params_.mu_occupied);
   std::size_t occupied = 0;
   if (mu_o > 0.0f)
-    for (const std::uint32_t i : occupied_cells_)
+    for (std::size_t k = 0; k < n_obstacle; ++k)
     {
+      const std::uint32_t i = obstacle_cell_[k];
+      if (i == kOutside) continue;
       if (m_o[i] != 0.0f) continue;
       if (m_f[i] > 0.0f) --free_cells;
       m_f[i] = 0.0f;
@@ -342,6 +393,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       m_omega[i] = 1.0f - mu_o;
       ++occupied;
     }
+  for (std::size_t k = 0; k < n_obstacle; ++k) st.obstacle_outside_grid += obstacle_cell_[k] == kOutside;
   st.occupied_cells = occupied;
   st.free_cells = free_cells;
   if (stats) *stats = st;

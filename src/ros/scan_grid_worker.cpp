@@ -62,6 +62,10 @@ ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "azimuth_resolution_deg", m.azimuth_resolution_deg);
   readParam(pnh, "min_range", m.min_range);
   readParam(pnh, "max_range", m.max_range);
+  readParam(pnh, "self_box_min_x", m.self_box_min_x);
+  readParam(pnh, "self_box_max_x", m.self_box_max_x);
+  readParam(pnh, "self_box_min_y", m.self_box_min_y);
+  readParam(pnh, "self_box_max_y", m.self_box_max_y);
   readParam(pnh, "ground_height", m.ground_height);
   readParam(pnh, "ground_tolerance", m.ground_tolerance);
   readParam(pnh, "obstacle_min_height", m.obstacle_min_height);
@@ -185,8 +189,9 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   Eigen::Isometry3d pose;
   try
   {
-    pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, cloud->header.frame_id, cloud->header.stamp)
-                       .transform);
+    const std::string& frame = cloud->header.frame_id;
+    const std::string source = frame.empty() || frame[0] != '/' ? frame : frame.substr(1);  // tf1-style "/lidar"
+    pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, source, cloud->header.stamp).transform);
     builder_.setSensorPose(pose);
   }
   catch (const tf2::TransformException& e)
@@ -290,6 +295,7 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("last cloud: non-finite", last_stats_.non_finite);
   status.add("last cloud: no return (0,0,0)", last_stats_.no_return);
   status.add("last cloud: out of range", last_stats_.below_min_range + last_stats_.beyond_max_range);
+  status.add("last cloud: self returns", last_stats_.self_returns);
   status.add("last cloud: ground / obstacle", std::to_string(last_stats_.ground) + " / " +
                                                   std::to_string(last_stats_.obstacle));
   status.add("last cloud: occupied / free cells", std::to_string(last_stats_.occupied_cells) + " / " +

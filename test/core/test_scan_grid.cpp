@@ -289,6 +289,29 @@ TEST(ScanGrid, HeightBandsAndRanges)
   expectUnknown(grid, 40, 40);
 }
 
+TEST(ScanGrid, SelfFilterDropsTheVehiclesOwnReturns)
+{
+  ScanGridParams p = testParams();
+  p.self_box_min_x = -1.0;
+  p.self_box_max_x = 3.0;
+  p.self_box_min_y = -1.0;
+  p.self_box_max_y = 1.0;
+  ScanGridBuilder builder(p, Eigen::Isometry3d(Eigen::Translation3d(1.0, 0.0, 1.8)));
+  auto pts = wall();  // sensor frame: the wall is at base_link x = 11.25, z = 2.8: above the clearance
+  for (auto& q : pts) q.z = -0.8f;  // 1 m above the ground
+  // Body returns 1.5 m ahead of the sensor (base_link x = 2.5, inside the box) would block the view.
+  for (int k = -10; k <= 10; ++k) pts.push_back({ 1.5f, 0.05f * k, -0.3f });
+  ScanMassGrid grid;
+  ScanGridStats st;
+  ASSERT_TRUE(builder.build(view(pts), grid, &st));
+  EXPECT_EQ(st.self_returns, 21u);
+  EXPECT_EQ(st.rejected(), 21u);
+  EXPECT_EQ(st.obstacle, 201u);
+  EXPECT_EQ(st.occupied_cells, 21u);  // the wall only, column floor((11.25 + 20) / 0.5) = 62
+  for (int y = 30; y <= 50; ++y) expectOccupied(grid, 62, y);
+  for (int x = 46; x < 62; ++x) expectFree(grid, x, 40);  // the view through the body is free
+}
+
 TEST(ScanGrid, GroundBeyondTheNearestObstacleDoesNotExtendFreeSpace)
 {
   ScanGridParams p = testParams();
@@ -425,6 +448,8 @@ TEST(ScanGrid, ParametersAreValidatedByName)
   expectError("min_range", [](ScanGridParams& p) { p.min_range = -1.0; });
   expectError("max_range", [](ScanGridParams& p) { p.max_range = 0.5, p.min_range = 1.0; });
   expectError("ground_tolerance", [](ScanGridParams& p) { p.ground_tolerance = -0.1; });
+  expectError("self_box_max_x", [](ScanGridParams& p) { p.self_box_min_x = 1.0; });
+  expectError("self_box_max_y", [](ScanGridParams& p) { p.self_box_max_y = -1.0; });
   expectError("obstacle_min_height", [](ScanGridParams& p) { p.obstacle_min_height = 0.1; });
   expectError("obstacle_max_height", [](ScanGridParams& p) { p.obstacle_max_height = 0.3; });
   expectError("mu_free", [](ScanGridParams& p) { p.mu_free = 1.5; });

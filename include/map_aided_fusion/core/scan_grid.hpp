@@ -13,10 +13,16 @@
  * - returns above the clearance height (canopies, bridges), below the ground band, or in the gap
  *   between the ground band and the obstacle band are neither;
  * - invalid returns (NaN/inf, the (0, 0, 0) "no return" point, horizontal range outside
- *   [min_range, max_range]) are never obstacles and are counted in ScanGridStats.
+ *   [min_range, max_range], returns from the vehicle's own body inside the self-filter box) are never
+ *   obstacles and are counted in ScanGridStats.
+ *
+ * Sectors tile the full turn from azimuth −180° (base_link axes), ceil(360 / azimuth_resolution_deg) of
+ * them. Cells closer to the sensor than min_range are never free (the sensor cannot see there); a cell
+ * holding an obstacle return is occupied even when the polar model calls it free.
  *
  * The Cartesian grid samples the polar model at each cell centre; the cell → (sector, range, μ_F(r))
- * table is computed once per (parameters, geometry, sensor position), not per scan.
+ * table is computed once per (parameters, geometry, sensor position), not per scan. It lists the cells of
+ * each sector by increasing range, so a scan only writes its free cells after resetting the planes.
  * ROS-free: Eigen and the standard library only.
  */
 #pragma once
@@ -47,6 +53,13 @@ struct ScanGridParams
   double azimuth_resolution_deg = 0.25;  ///< width of an azimuth sector, degrees, in [0.01, 45]
   double min_range = 1.0;                ///< horizontal range below which a return is rejected, m (≥ 0)
   double max_range = 80.0;               ///< horizontal range beyond which a return is rejected, m (> min_range)
+
+  // Self filter: returns strictly inside this base_link box (the vehicle's own body) are rejected.
+  // The default empty box disables it.
+  double self_box_min_x = 0.0;  ///< m
+  double self_box_max_x = 0.0;  ///< m (≥ self_box_min_x)
+  double self_box_min_y = 0.0;  ///< m
+  double self_box_max_y = 0.0;  ///< m (≥ self_box_min_y)
 
   // Heights in base_link.
   double ground_height = 0.0;        ///< z of the ground surface in base_link, m
@@ -106,6 +119,7 @@ struct ScanGridStats
   std::size_t no_return = 0;            ///< exactly (0, 0, 0) in the sensor frame
   std::size_t below_min_range = 0;      ///< horizontal range < min_range
   std::size_t beyond_max_range = 0;     ///< horizontal range > max_range
+  std::size_t self_returns = 0;         ///< inside the self-filter box (the vehicle's body)
   std::size_t ground = 0;               ///< ground returns
   std::size_t obstacle = 0;             ///< obstacle returns
   std::size_t obstacle_outside_grid = 0;///< obstacle returns outside the grid (still bound free space)
@@ -115,7 +129,7 @@ struct ScanGridStats
   std::size_t occupied_cells = 0;       ///< cells with m(O) = μ_O
   std::size_t free_cells = 0;           ///< cells with m(F) > 0
 
-  std::size_t rejected() const { return non_finite + no_return + below_min_range + beyond_max_range; }
+  std::size_t rejected() const { return non_finite + no_return + below_min_range + beyond_max_range + self_returns; }
 };
 
 /**
@@ -172,17 +186,27 @@ private:
   double table_sensor_x_ = 0.0;  // sensor position the table was computed for
   double table_sensor_y_ = 0.0;
 
-  // Table, one entry per cell.
-  std::vector<std::uint16_t> cell_sector_;
-  AlignedVector<float> cell_range_;
-  AlignedVector<float> cell_free_;
+  /// A cell of the table: squared range from the sensor, index, μ_F(r).
+  struct TableEntry
+  {
+    float range2;
+    std::uint32_t cell;
+    float mu_free;
+  };
+  // Table: the cells in [min_range, max_range] grouped by sector, each group sorted by range, so that
+  // the free cells of a sector are a prefix of its group.
+  std::vector<TableEntry> table_;
+  std::vector<std::uint32_t> sector_begin_;  // group of sector s: [sector_begin_[s], sector_begin_[s + 1])
 
-  // Scratch, reused between scans.
-  std::vector<float> sector_obstacle_;
-  std::vector<float> sector_free_;
-  std::vector<std::uint32_t> ground_hits_;  // sector of each ground return, packed with ground_range_
-  std::vector<float> ground_range_;
-  std::vector<std::uint32_t> occupied_cells_;
+  // Scratch, reused between scans: per sector the squared range of the nearest obstacle and of the free
+  // limit; the ground and obstacle returns of the scan, compacted (sector, squared range, cell).
+  std::vector<float> sector_obstacle2_;
+  std::vector<float> sector_free2_;
+  std::vector<std::uint32_t> ground_sector_;
+  std::vector<float> ground_range2_;
+  std::vector<std::uint32_t> obstacle_sector_;
+  std::vector<float> obstacle_range2_;
+  std::vector<std::uint32_t> obstacle_cell_;
 };
 
 }  // namespace core
