@@ -18,3 +18,10 @@ target_link_libraries(evaluate map_aided_fusion_eval map_aided_fusion_map_io map
   yaml-cpp ${catkin_LIBRARIES})
 add_dependencies(evaluate ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+if(CATKIN_ENABLE_TESTING)
+  add_rostest_gtest(test_demo_scores test/demo.test test/ros/test_demo_scores.cpp)
+  target_link_libraries(test_demo_scores map_aided_fusion_eval ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+  add_dependencies(tests simulate evaluate map_aided_fusion_fusion_nodelet map_aided_fusion_scan_grid_nodelet
+    map_aided_fusion_prior_grid_nodelet)
+endif()

@@ -3,6 +3,8 @@
 
 MAF_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 MAF_BUILD="${MAF_BUILD:-$MAF_ROOT/build}"
+# The package's executables (rosrun does not look under <package>/build, where these scripts build).
+MAF_BIN="$MAF_BUILD/devel/lib/map_aided_fusion"
 # Debian's ROS Python modules live in /usr/bin/python3, not in a pyenv or virtualenv python.
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export PYTHONNOUSERSITE=1

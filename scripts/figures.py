@@ -48,7 +48,10 @@ def betp_to_rgb(betp, decision):
 
 
 def draw_objects(ax, meta, with_labels=False):
+    x0, x1, y0, y1 = extent(meta["grid"])
     for o in meta["objects"]:
+        if not (x0 <= o["x"] <= x1 and y0 <= o["y"] <= y1):
+            continue
         if o["class"] not in OBJECT_EDGE:
             continue
         c, s = np.cos(o["yaw"]), np.sin(o["yaw"])
@@ -57,7 +60,7 @@ def draw_objects(ax, meta, with_labels=False):
                                        edgecolor=OBJECT_EDGE[o["class"]], linewidth=1.2))
         if with_labels and o["class"] in (3, 4):
             ax.text(o["x"], o["y"] + 0.6 * max(o["length"], o["width"]), o["kind"], color=OBJECT_EDGE[o["class"]],
-                    fontsize=6, ha="center")
+                    fontsize=6, ha="center", clip_on=True)
     e = meta["ego"]
     c, s = np.cos(e["yaw"]), np.sin(e["yaw"])
     length, width = 4.5, 2.0

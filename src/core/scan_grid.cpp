@@ -89,6 +89,7 @@ void ScanGridParams::validate() const
   requireUnit("mu_free", mu_free);
   requireUnit("mu_occupied", mu_occupied);
   requireInRange("free_decay_length", free_decay_length, 0.0, std::numeric_limits<double>::max());
+  requireInRange("free_margin", free_margin, 0.0, max_range);
   const double cells = std::round(grid_size_x / grid_resolution) * std::round(grid_size_y / grid_resolution);
   if (!(cells <= static_cast<double>(kScanGridMaxCells)))
     throw ParameterError("grid_size_x", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
@@ -347,12 +348,23 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   std::fill(sector_obstacle2_.begin(), sector_obstacle2_.end(), kInfinity);
   for (std::size_t k = 0; k < n_obstacle; ++k)
     obstacle2[obstacle_sector_[k]] = std::min(obstacle2[obstacle_sector_[k]], obstacle_range2_[k]);
-  for (std::size_t s = 0; s < sector_free2_.size(); ++s) free2[s] = std::isinf(obstacle2[s]) ? 0.0f : obstacle2[s];
+  const float margin = static_cast<float>(params_.free_margin);
+  for (std::size_t s = 0; s < sector_free2_.size(); ++s)
+  {
+    if (std::isinf(obstacle2[s]))
+    {
+      free2[s] = 0.0f;
+      continue;
+    }
+    const float limit = std::max(0.0f, std::sqrt(obstacle2[s]) - margin);
+    free2[s] = limit * limit;
+  }
   for (std::size_t k = 0; k < n_ground; ++k)
   {
     const std::uint32_t s = ground_sector_[k];
     const float r2 = ground_range2_[k];
-    if (r2 < obstacle2[s] && r2 > free2[s]) free2[s] = r2;
+    if (r2 < obstacle2[s] && r2 > free2[s] && (margin == 0.0f || std::sqrt(r2) < std::sqrt(obstacle2[s]) - margin))
+      free2[s] = r2;
   }
 
   float* const m_empty = grid.plane(FrameSG::kEmpty);

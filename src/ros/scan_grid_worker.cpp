@@ -73,6 +73,7 @@ ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "mu_free", m.mu_free);
   readParam(pnh, "mu_occupied", m.mu_occupied);
   readParam(pnh, "free_decay_length", m.free_decay_length);
+  readParam(pnh, "free_margin", m.free_margin);
   p.validate();
   return p;
 }
@@ -255,6 +256,7 @@ void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level
   m.mu_free = config.mu_free;
   m.mu_occupied = config.mu_occupied;
   m.free_decay_length = config.free_decay_length;
+  m.free_margin = config.free_margin;
   try
   {
     builder_.configure(m, builder_.sensorPose());

@@ -136,6 +136,7 @@ core::ScanGridParams scanGridParams(const YAML::Node& n)
   yamlRead(n, "mu_free", p.mu_free);
   yamlRead(n, "mu_occupied", p.mu_occupied);
   yamlRead(n, "free_decay_length", p.free_decay_length);
+  yamlRead(n, "free_margin", p.free_margin);
   p.validate();
   return p;
 }

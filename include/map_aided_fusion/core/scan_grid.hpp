@@ -71,6 +71,12 @@ struct ScanGridParams
   double mu_free = 0.7;              ///< μ_F: free mass between the sensor and a return, in [0, 1]
   double mu_occupied = 0.8;          ///< μ_O: occupied mass of a cell holding an obstacle return, in [0, 1]
   double free_decay_length = 0.0;    ///< μ_F(r) = μ_F·exp(−r / L), m; 0 disables the decay (≥ 0)
+  /**
+   * Cells closer than this to a sector's nearest obstacle (in range) are left unknown rather than free, m (≥ 0):
+   * a wall seen at a grazing angle or from a moving vehicle otherwise flickers between free and occupied in
+   * its boundary cells, which the fusion reads as a moving object.
+   */
+  double free_margin = 0.0;
 
   /// The grid described by the grid_* parameters.
   GridGeometry geometry() const
