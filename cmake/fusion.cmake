@@ -1,7 +1,6 @@
 # Fusion component: FusionNodelet, fusion_node, their tests and benchmarks.
 add_library(map_aided_fusion_fusion_nodelet
   src/ros/fusion_worker.cpp
-  src/ros/param_loading.cpp
   src/ros/visualization.cpp
   src/nodelets/fusion_nodelet.cpp
 )

@@ -18,23 +18,7 @@ void readParam(const ros::NodeHandle& nh, const std::string& name, double& value
 core::MapGridParams loadMapGridParams(const ros::NodeHandle& nh)
 {
   core::MapGridParams p;
-  readParam(nh, "size_x", p.size_x);
-  readParam(nh, "size_y", p.size_y);
-  readParam(nh, "resolution", p.resolution);
-  readParam(nh, "recentre_distance", p.recentre_distance);
-  readParam(nh, "alpha_static", p.fusion.discount.alpha_static);
-  readParam(nh, "alpha_dynamic", p.fusion.discount.alpha_dynamic);
-  readParam(nh, "alpha_free", p.fusion.discount.alpha_free);
-  readParam(nh, "alpha_per_second", p.rates_per_second);
-  readParam(nh, "delta_inc", p.fusion.counter.delta_inc);
-  readParam(nh, "delta_dec", p.fusion.counter.delta_dec);
-  readParam(nh, "gamma_occupied", p.fusion.counter.gamma_occupied);
-  readParam(nh, "gamma_conflict", p.fusion.counter.gamma_conflict);
-  bool literal = p.fusion.counter.mode == core::SpecialisationMode::kLiteral;
-  readParam(nh, "specialise_literal", literal);
-  p.fusion.counter.mode = literal ? core::SpecialisationMode::kLiteral : core::SpecialisationMode::kMovingToStopped;
-  readParam(nh, "decision_threshold", p.decision_threshold);
-  readParam(nh, "min_object_cells", p.min_object_cells);
+  core::forEachParam(p, parameterServerReader(nh));
   p.validate();
   return p;
 }

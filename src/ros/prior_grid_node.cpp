@@ -10,6 +10,7 @@
 #include "map_aided_fusion/EvidentialGrid.h"
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/ros/conversions.hpp"
+#include "map_aided_fusion/ros/param_loading.hpp"
 
 namespace map_aided_fusion {
 
@@ -80,11 +81,7 @@ visualization_msgs::Marker lineList(const std_msgs::Header& header, const std::s
 map_io::PriorGridParams readPriorGridParams(const ros::NodeHandle& pnh)
 {
   map_io::PriorGridParams p;
-  map_io::forEachPriorGridParam(p, [&pnh](const std::string& name, auto& value) {
-    if (!pnh.hasParam(name)) return;
-    if (!pnh.getParam(name, value))
-      throw core::ParameterError(name, "has the wrong type (see config/prior_grid.yaml)");
-  });
+  map_io::forEachPriorGridParam(p, parameterServerReader(pnh));
   return p;
 }
 

@@ -9,6 +9,7 @@
 #include "map_aided_fusion/EvidentialGrid.h"
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/ros/conversions.hpp"
+#include "map_aided_fusion/ros/param_loading.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
 
 namespace map_aided_fusion {
@@ -17,15 +18,6 @@ namespace {
 
 constexpr int kMaxQueueSize = 1000;
 constexpr double kMillisecondsPerSecond = 1000.0;
-
-/// Reads @p name into @p value when present; a present parameter of the wrong type is an error.
-template <class T>
-void readParam(const ros::NodeHandle& pnh, const std::string& name, T& value)
-{
-  if (!pnh.hasParam(name)) return;
-  if (!pnh.getParam(name, value))
-    throw core::ParameterError(name, "present in " + pnh.getNamespace() + " but of the wrong type");
-}
 
 Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
 {
@@ -53,27 +45,7 @@ ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "input_queue_size", p.input_queue_size);
   readParam(pnh, "tf_queue_size", p.tf_queue_size);
   readParam(pnh, "diagnostic_period", p.diagnostic_period);
-  core::ScanGridParams& m = p.model;
-  readParam(pnh, "grid_resolution", m.grid_resolution);
-  readParam(pnh, "grid_size_x", m.grid_size_x);
-  readParam(pnh, "grid_size_y", m.grid_size_y);
-  readParam(pnh, "grid_offset_x", m.grid_offset_x);
-  readParam(pnh, "grid_offset_y", m.grid_offset_y);
-  readParam(pnh, "azimuth_resolution_deg", m.azimuth_resolution_deg);
-  readParam(pnh, "min_range", m.min_range);
-  readParam(pnh, "max_range", m.max_range);
-  readParam(pnh, "self_box_min_x", m.self_box_min_x);
-  readParam(pnh, "self_box_max_x", m.self_box_max_x);
-  readParam(pnh, "self_box_min_y", m.self_box_min_y);
-  readParam(pnh, "self_box_max_y", m.self_box_max_y);
-  readParam(pnh, "ground_height", m.ground_height);
-  readParam(pnh, "ground_tolerance", m.ground_tolerance);
-  readParam(pnh, "obstacle_min_height", m.obstacle_min_height);
-  readParam(pnh, "obstacle_max_height", m.obstacle_max_height);
-  readParam(pnh, "mu_free", m.mu_free);
-  readParam(pnh, "mu_occupied", m.mu_occupied);
-  readParam(pnh, "free_decay_length", m.free_decay_length);
-  readParam(pnh, "free_margin", m.free_margin);
+  core::forEachParam(p.model, parameterServerReader(pnh));
   p.validate();
   return p;
 }

@@ -31,6 +31,9 @@
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/eval/metrics.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
+#include "map_aided_fusion/map_io/prior_grid_params.hpp"
+#include "map_aided_fusion/map_io/yaml_params.hpp"
+#include "map_aided_fusion/ros/eval_conversions.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
 
 namespace fs = std::filesystem;
@@ -75,45 +78,10 @@ void usage()
 
 // ---- configuration files (the nodelets' YAML files, read without a ROS master) -------------------------
 
-template <typename T>
-void yamlRead(const YAML::Node& n, const char* key, T& value)
-{
-  if (n && n[key]) value = n[key].as<T>();
-}
-
-YAML::Node loadYaml(const std::string& path)
-{
-  if (path.empty()) return YAML::Node();
-  try
-  {
-    return YAML::LoadFile(path);
-  }
-  catch (const YAML::Exception& e)
-  {
-    throw std::runtime_error("cannot read " + path + ": " + e.what());
-  }
-}
-
 core::MapGridParams fusionParams(const YAML::Node& n)
 {
   core::MapGridParams p;
-  yamlRead(n, "size_x", p.size_x);
-  yamlRead(n, "size_y", p.size_y);
-  yamlRead(n, "resolution", p.resolution);
-  yamlRead(n, "recentre_distance", p.recentre_distance);
-  yamlRead(n, "alpha_static", p.fusion.discount.alpha_static);
-  yamlRead(n, "alpha_dynamic", p.fusion.discount.alpha_dynamic);
-  yamlRead(n, "alpha_free", p.fusion.discount.alpha_free);
-  yamlRead(n, "alpha_per_second", p.rates_per_second);
-  yamlRead(n, "delta_inc", p.fusion.counter.delta_inc);
-  yamlRead(n, "delta_dec", p.fusion.counter.delta_dec);
-  yamlRead(n, "gamma_occupied", p.fusion.counter.gamma_occupied);
-  yamlRead(n, "gamma_conflict", p.fusion.counter.gamma_conflict);
-  bool literal = false;
-  yamlRead(n, "specialise_literal", literal);
-  if (literal) p.fusion.counter.mode = core::SpecialisationMode::kLiteral;
-  yamlRead(n, "decision_threshold", p.decision_threshold);
-  yamlRead(n, "min_object_cells", p.min_object_cells);
+  core::forEachParam(p, map_io::yamlReader(n));
   p.validate();
   return p;
 }
@@ -121,22 +89,7 @@ core::MapGridParams fusionParams(const YAML::Node& n)
 core::ScanGridParams scanGridParams(const YAML::Node& n)
 {
   core::ScanGridParams p;
-  yamlRead(n, "grid_resolution", p.grid_resolution);
-  yamlRead(n, "grid_size_x", p.grid_size_x);
-  yamlRead(n, "grid_size_y", p.grid_size_y);
-  yamlRead(n, "grid_offset_x", p.grid_offset_x);
-  yamlRead(n, "grid_offset_y", p.grid_offset_y);
-  yamlRead(n, "azimuth_resolution_deg", p.azimuth_resolution_deg);
-  yamlRead(n, "min_range", p.min_range);
-  yamlRead(n, "max_range", p.max_range);
-  yamlRead(n, "ground_height", p.ground_height);
-  yamlRead(n, "ground_tolerance", p.ground_tolerance);
-  yamlRead(n, "obstacle_min_height", p.obstacle_min_height);
-  yamlRead(n, "obstacle_max_height", p.obstacle_max_height);
-  yamlRead(n, "mu_free", p.mu_free);
-  yamlRead(n, "mu_occupied", p.mu_occupied);
-  yamlRead(n, "free_decay_length", p.free_decay_length);
-  yamlRead(n, "free_margin", p.free_margin);
+  core::forEachParam(p, map_io::yamlReader(n));
   p.validate();
   return p;
 }
@@ -193,35 +146,6 @@ const V* nearest(const std::map<std::int64_t, V>& m, const ros::Time& t)
   if (it != m.end()) consider(it);
   if (it != m.begin()) consider(std::prev(it));
   return best;
-}
-
-eval::ClassGrid fromOccupancy(const nav_msgs::OccupancyGrid& g)
-{
-  eval::ClassGrid c;
-  c.geometry = core::GridGeometry{ g.info.resolution, static_cast<int>(g.info.width), static_cast<int>(g.info.height),
-                                   g.info.origin.position.x, g.info.origin.position.y };
-  c.cells = g.data;
-  if (c.cells.size() != c.geometry.numCells()) throw std::runtime_error("ground truth grid with a wrong data size");
-  return c;
-}
-
-std::vector<eval::TruthObject> fromObjects(const GroundTruthObjectArray& a)
-{
-  std::vector<eval::TruthObject> out;
-  for (const auto& o : a.objects)
-  {
-    eval::TruthObject t;
-    t.id = o.id;
-    t.cell_class = static_cast<CellClass>(o.cell_class);
-    t.kind = o.kind;
-    t.centre = core::Point2{ o.pose.position.x, o.pose.position.y };
-    t.yaw = tf2::getYaw(o.pose.orientation);
-    t.length = o.size.x;
-    t.width = o.size.y;
-    t.speed = std::hypot(o.velocity.x, o.velocity.y);
-    out.push_back(t);
-  }
-  return out;
 }
 
 // ---- pipeline variants -----------------------------------------------------------------------------------
@@ -310,31 +234,23 @@ Options parse(int argc, char** argv)
 
 core::PriorWindow loadPrior(const Options& o, const YAML::Node& prior_cfg, double resolution, std::string& summary)
 {
-  map_io::MapLoadParams lp;
-  lp.file = o.map;
-  if (lp.file.empty()) yamlRead(prior_cfg, "map_file", lp.file);
-  if (lp.file.empty()) throw std::runtime_error("no map: give --map or map_file in the prior config");
-  yamlRead(prior_cfg, "origin_latitude", lp.origin_latitude);
-  yamlRead(prior_cfg, "origin_longitude", lp.origin_longitude);
-  yamlRead(prior_cfg, "origin_altitude", lp.origin_altitude);
-  yamlRead(prior_cfg, "metric", lp.metric);
+  map_io::PriorGridParams pp;
+  map_io::forEachPriorGridParam(pp, map_io::yamlReader(prior_cfg));
+  if (!o.map.empty()) pp.map.file = o.map;
+  if (pp.map.file.empty()) throw std::runtime_error("no map: give --map or map_file in the prior config");
   if (o.origin)
   {
-    lp.origin_latitude = (*o.origin)[0];
-    lp.origin_longitude = (*o.origin)[1];
-    lp.origin_altitude = (*o.origin)[2];
+    pp.map.origin_latitude = (*o.origin)[0];
+    pp.map.origin_longitude = (*o.origin)[1];
+    pp.map.origin_altitude = (*o.origin)[2];
   }
-  core::PriorConfidence beta;
-  yamlRead(prior_cfg, "beta_building", beta.beta_building);
-  yamlRead(prior_cfg, "beta_road", beta.beta_road);
-  yamlRead(prior_cfg, "beta_other", beta.beta_other);
-  beta.validate();
+  pp.beta.validate();
   map_io::MapLoadReport report;
-  const core::VectorMap vm = map_io::loadVectorMap(lp, &report);
+  const core::VectorMap vm = map_io::loadVectorMap(pp.map, &report);
   const core::PriorGrid grid = core::PriorGrid::fromVectorMap(vm, resolution);
   core::PriorWindow window;
-  grid.fillWindow(grid.geometry(), beta, window);
-  summary = lp.file + ": " + std::to_string(vm.buildings.size()) + " buildings, " +
+  grid.fillWindow(grid.geometry(), pp.beta, window);
+  summary = pp.map.file + ": " + std::to_string(vm.buildings.size()) + " buildings, " +
             std::to_string(vm.road_areas.size()) + " road surfaces";
   return window;
 }
@@ -356,9 +272,9 @@ int main(int argc, char** argv)
   }
   try
   {
-    const YAML::Node fusion_cfg = loadYaml(opt.fusion_config);
-    const YAML::Node scan_cfg = loadYaml(opt.scan_grid_config);
-    const YAML::Node prior_cfg = loadYaml(opt.prior_config);
+    const YAML::Node fusion_cfg = map_io::loadYamlFile(opt.fusion_config);
+    const YAML::Node scan_cfg = map_io::loadYamlFile(opt.scan_grid_config);
+    const YAML::Node prior_cfg = map_io::loadYamlFile(opt.prior_config);
     const core::MapGridParams params = fusionParams(fusion_cfg);
     const core::ScanGridParams scan_params = scanGridParams(scan_cfg);
     std::string prior_summary;
@@ -383,12 +299,12 @@ int main(int argc, char** argv)
         }
         else if (topic == "/ground_truth/classes")
         {
-          if (auto msg = m.instantiate<nav_msgs::OccupancyGrid>()) truth[key(msg->header.stamp)] = fromOccupancy(*msg);
+          if (auto msg = m.instantiate<nav_msgs::OccupancyGrid>()) truth[key(msg->header.stamp)] = toClassGrid(*msg);
         }
         else if (topic == "/ground_truth/objects")
         {
           if (auto msg = m.instantiate<GroundTruthObjectArray>())
-            truth_objects[key(msg->header.stamp)] = fromObjects(*msg);
+            truth_objects[key(msg->header.stamp)] = toTruthObjects(*msg);
         }
         else if (topic == "/points")
         {
@@ -588,7 +504,7 @@ int main(int argc, char** argv)
         if (!d) continue;
         const eval::ClassGrid* gt = nearest(truth, d->header.stamp);
         if (!gt) continue;
-        const eval::ClassGrid decision = fromOccupancy(*d);
+        const eval::ClassGrid decision = toClassGrid(*d);
         eval::accumulate(*gt, decision, s.confusion);
         const auto* objects = nearest(truth_objects, d->header.stamp);
         s.objects.add(d->header.stamp.toSec(), *gt, objects ? *objects : std::vector<eval::TruthObject>{}, decision);

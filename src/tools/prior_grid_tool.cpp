@@ -17,6 +17,7 @@
 #include "map_aided_fusion/map_io/map_loader.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
 #include "map_aided_fusion/map_io/prior_png.hpp"
+#include "map_aided_fusion/map_io/yaml_params.hpp"
 
 using namespace map_aided_fusion;
 
@@ -70,27 +71,7 @@ bool parseOrigin(const std::string& s, map_io::MapLoadParams& p)
 /// Reads the keys of config/prior_grid.yaml from a YAML file into @p p (absent keys keep their values).
 void readYaml(const std::string& path, map_io::PriorGridParams& p)
 {
-  YAML::Node root;
-  try
-  {
-    root = YAML::LoadFile(path);
-  }
-  catch (const YAML::Exception& e)
-  {
-    throw std::runtime_error("config '" + path + "': " + e.what());
-  }
-  map_io::forEachPriorGridParam(p, [&root](const std::string& name, auto& value) {
-    const YAML::Node n = root[name];
-    if (!n) return;
-    try
-    {
-      value = n.as<std::remove_reference_t<decltype(value)>>();
-    }
-    catch (const YAML::Exception&)
-    {
-      throw core::ParameterError(name, "has the wrong type (see config/prior_grid.yaml)");
-    }
-  });
+  map_io::forEachPriorGridParam(p, map_io::yamlReader(map_io::loadYamlFile(path)));
 }
 
 double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b)

@@ -16,36 +16,11 @@
 
 #include "map_aided_fusion/GroundTruthObjectArray.h"
 #include "map_aided_fusion/eval/metrics.hpp"
+#include "map_aided_fusion/ros/eval_conversions.hpp"
 
 using namespace map_aided_fusion;
 
 namespace {
-
-eval::ClassGrid toClassGrid(const nav_msgs::OccupancyGrid& g)
-{
-  eval::ClassGrid c;
-  c.geometry = core::GridGeometry{ g.info.resolution, static_cast<int>(g.info.width), static_cast<int>(g.info.height),
-                                   g.info.origin.position.x, g.info.origin.position.y };
-  c.cells = g.data;
-  return c;
-}
-
-std::vector<eval::TruthObject> toObjects(const GroundTruthObjectArray& a)
-{
-  std::vector<eval::TruthObject> out;
-  for (const auto& o : a.objects)
-  {
-    eval::TruthObject t;
-    t.id = o.id;
-    t.cell_class = static_cast<core::CellClass>(o.cell_class);
-    t.centre = core::Point2{ o.pose.position.x, o.pose.position.y };
-    t.yaw = tf2::getYaw(o.pose.orientation);
-    t.length = o.size.x;
-    t.width = o.size.y;
-    out.push_back(t);
-  }
-  return out;
-}
 
 double param(const std::string& name)
 {
@@ -91,7 +66,7 @@ TEST(DemoLaunch, HeadlineScoresStayAboveFloors)
                                                                                       "/ground_truth/objects" })))
   {
     if (auto g = m.instantiate<nav_msgs::OccupancyGrid>()) truth[g->header.stamp.toNSec()] = toClassGrid(*g);
-    if (auto o = m.instantiate<GroundTruthObjectArray>()) objects[o->header.stamp.toNSec()] = toObjects(*o);
+    if (auto o = m.instantiate<GroundTruthObjectArray>()) objects[o->header.stamp.toNSec()] = toTruthObjects(*o);
   }
   eval::ConfusionMatrix confusion;
   eval::ObjectScorer scorer;

@@ -48,6 +48,32 @@ struct MapGridParams
   void validate() const;
 };
 
+/**
+ * @brief Calls get(name, field) for every parameter of @p p, with the names of config/fusion.yaml: one list
+ *        shared by the ROS loader and the YAML loader of the offline tools.
+ */
+template <class Get>
+void forEachParam(MapGridParams& p, Get&& get)
+{
+  get("size_x", p.size_x);
+  get("size_y", p.size_y);
+  get("resolution", p.resolution);
+  get("recentre_distance", p.recentre_distance);
+  get("alpha_static", p.fusion.discount.alpha_static);
+  get("alpha_dynamic", p.fusion.discount.alpha_dynamic);
+  get("alpha_free", p.fusion.discount.alpha_free);
+  get("alpha_per_second", p.rates_per_second);
+  get("delta_inc", p.fusion.counter.delta_inc);
+  get("delta_dec", p.fusion.counter.delta_dec);
+  get("gamma_occupied", p.fusion.counter.gamma_occupied);
+  get("gamma_conflict", p.fusion.counter.gamma_conflict);
+  bool literal = p.fusion.counter.mode == SpecialisationMode::kLiteral;
+  get("specialise_literal", literal);
+  p.fusion.counter.mode = literal ? SpecialisationMode::kLiteral : SpecialisationMode::kMovingToStopped;
+  get("decision_threshold", p.decision_threshold);
+  get("min_object_cells", p.min_object_cells);
+}
+
 /// Wall time of each stage of MapGrid::update(), seconds.
 struct StageTimes
 {

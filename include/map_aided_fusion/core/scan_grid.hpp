@@ -88,6 +88,35 @@ struct ScanGridParams
   void validate() const;
 };
 
+/**
+ * @brief Calls get(name, field) for every parameter of @p p, with the names of config/scan_grid.yaml: one list
+ *        shared by the ROS loader and the YAML loader of the offline tools.
+ */
+template <class Get>
+void forEachParam(ScanGridParams& p, Get&& get)
+{
+  get("grid_resolution", p.grid_resolution);
+  get("grid_size_x", p.grid_size_x);
+  get("grid_size_y", p.grid_size_y);
+  get("grid_offset_x", p.grid_offset_x);
+  get("grid_offset_y", p.grid_offset_y);
+  get("azimuth_resolution_deg", p.azimuth_resolution_deg);
+  get("min_range", p.min_range);
+  get("max_range", p.max_range);
+  get("self_box_min_x", p.self_box_min_x);
+  get("self_box_max_x", p.self_box_max_x);
+  get("self_box_min_y", p.self_box_min_y);
+  get("self_box_max_y", p.self_box_max_y);
+  get("ground_height", p.ground_height);
+  get("ground_tolerance", p.ground_tolerance);
+  get("obstacle_min_height", p.obstacle_min_height);
+  get("obstacle_max_height", p.obstacle_max_height);
+  get("mu_free", p.mu_free);
+  get("mu_occupied", p.mu_occupied);
+  get("free_decay_length", p.free_decay_length);
+  get("free_margin", p.free_margin);
+}
+
 /// Largest grid the builder accepts (cells), to refuse absurd sizes before allocating.
 constexpr std::size_t kScanGridMaxCells = std::size_t(1) << 26;
 

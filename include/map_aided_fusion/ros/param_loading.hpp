@@ -25,6 +25,12 @@ void readParam(const ros::NodeHandle& nh, const std::string& name, T& value)
 /// double parameters may be written as integers in YAML.
 void readParam(const ros::NodeHandle& nh, const std::string& name, double& value);
 
+/// A getter for core::forEachParam() that reads from @p nh (absent parameters keep their defaults).
+inline auto parameterServerReader(const ros::NodeHandle& nh)
+{
+  return [&nh](const std::string& name, auto& value) { readParam(nh, name, value); };
+}
+
 /**
  * @brief The MapGrid parameters from @p nh (the fusion nodelet's private namespace; see config/fusion.yaml).
  * @throws core::ParameterError naming the parameter that is missing its type or out of range.
