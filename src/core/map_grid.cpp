@@ -15,6 +15,8 @@ namespace {
 
 /// Largest window side, in cells (a 8192 × 8192 MapGrid already needs 8.6 GB).
 constexpr int kMaxWindowCells = 8192;
+/// Side of the square tiles projectScan() walks the window in, cells.
+constexpr int kProjectTile = 32;
 /// m(Ω) at or above 1 − this is a vacuous cell.
 constexpr float kVacuousTolerance = 1e-3f;
 
@@ -59,54 +61,57 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
 {
   if (out.geometry() != window) out.reset(window);
   const GridGeometry& sg = scan.geometry();
-  float* dst[FrameSG::kNumSubsets];
-  const float* src[FrameSG::kNumSubsets];
-  for (int a = 0; a < FrameSG::kNumSubsets; ++a)
-  {
-    dst[a] = out.plane(static_cast<Subset>(a));
-    src[a] = scan.plane(static_cast<Subset>(a));
-  }
+  // m(∅) of a ScanGrid is not used by the fusion: only F, O and Ω are mapped (∅ stays 0 in out).
+  float* const df = out.plane(FrameSG::kF);
+  float* const d_o = out.plane(FrameSG::kO);
+  float* const dw = out.plane(FrameSG::kOmega);
+  const float* const sf = scan.plane(FrameSG::kF);
+  const float* const s_o = scan.plane(FrameSG::kO);
+  const float* const sw = scan.plane(FrameSG::kOmega);
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  // Inverse mapping: window cell centre → vehicle frame → scan cell.
-  for (int y = 0; y < window.height; ++y)
-  {
-    const Point2 first = window.cellCentre(CellIndex{ 0, y });
-    const double dx = first.x - pose.x, dy = first.y - pose.y;
-    const double vx = c * dx + s * dy, vy = -s * dx + c * dy;
-    const double step_x = c * window.resolution, step_y = -s * window.resolution;
-    const double inv_res = 1.0 / sg.resolution;
-    double fx = (vx - sg.origin_x) * inv_res, fy = (vy - sg.origin_y) * inv_res;
-    const double dfx = step_x * inv_res, dfy = step_y * inv_res;
-    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(window.width);
-    for (int x = 0; x < window.width; ++x, fx += dfx, fy += dfy)
-    {
-      const std::size_t j = row + static_cast<std::size_t>(x);
-      if (fx >= 0.0 && fy >= 0.0 && fx < sg.width && fy < sg.height)
+  const double inv_res = 1.0 / sg.resolution;
+  const double dfx = c * window.resolution * inv_res, dfy = -s * window.resolution * inv_res;
+  const int w = window.width, h = window.height;
+  // Inverse mapping: window cell centre → vehicle frame → scan cell. Tiles keep the (rotated) reads local.
+  const Point2 corner = window.cellCentre(CellIndex{ 0, 0 });
+  const double dx0 = corner.x - pose.x, dy0 = corner.y - pose.y;
+  const double fx00 = (c * dx0 + s * dy0 - sg.origin_x) * inv_res, fy00 = (-s * dx0 + c * dy0 - sg.origin_y) * inv_res;
+  const double drx = s * window.resolution * inv_res, dry = c * window.resolution * inv_res;  // per window row
+  const double sw_max = sg.width, sh_max = sg.height;
+  for (int ty = 0; ty < h; ty += kProjectTile)
+    for (int tx = 0; tx < w; tx += kProjectTile)
+      for (int y = ty; y < std::min(h, ty + kProjectTile); ++y)
       {
-        const std::size_t i = static_cast<std::size_t>(fy) * static_cast<std::size_t>(sg.width) + static_cast<std::size_t>(fx);
-        dst[0][j] = src[0][i];
-        dst[1][j] = src[1][i];
-        dst[2][j] = src[2][i];
-        dst[3][j] = src[3][i];
+        const double fxr = fx00 + y * drx, fyr = fy00 + y * dry;
+        const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+        for (int x = tx; x < std::min(w, tx + kProjectTile); ++x)
+        {
+          const double fx = fxr + x * dfx, fy = fyr + x * dfy;
+          const std::size_t j = row + static_cast<std::size_t>(x);
+          if (fx >= 0.0 && fy >= 0.0 && fx < sw_max && fy < sh_max)
+          {
+            const std::size_t i =
+                static_cast<std::size_t>(fy) * static_cast<std::size_t>(sg.width) + static_cast<std::size_t>(fx);
+            df[j] = sf[i];
+            d_o[j] = s_o[i];
+            dw[j] = sw[i];
+          }
+          else
+          {
+            df[j] = d_o[j] = 0.0f;
+            dw[j] = 1.0f;
+          }
+        }
       }
-      else
-      {
-        dst[0][j] = dst[1][j] = dst[2][j] = 0.0f;
-        dst[3][j] = 1.0f;
-      }
-    }
-  }
   // Forward pass: every occupied scan cell marks the window cell under its centre.
-  const float* so = scan.plane(FrameSG::kO);
-  float* wo = out.plane(FrameSG::kO);
   for (std::size_t i = 0; i < scan.numCells(); ++i)
   {
-    if (so[i] <= 0.0f) continue;
+    if (s_o[i] <= 0.0f) continue;
     const Point2 v = sg.cellCentre(sg.cellOf(i));
     CellIndex wc;
     if (!window.worldToCell(Point2{ pose.x + c * v.x - s * v.y, pose.y + s * v.x + c * v.y }, wc)) continue;
     const std::size_t j = window.index(wc);
-    if (so[i] > wo[j]) copyCell(scan, i, out, j);
+    if (s_o[i] > d_o[j]) copyCell(scan, i, out, j);
   }
 }
 
