@@ -206,12 +206,15 @@ TEST(ScanGridNodelet, PublishesGridsWithTheCloudStampAndSurvivesMalformedClouds)
 
   // 2. Malformed clouds: no z field; data shorter than width * height * point_step.
   const ros::Time t2(1001, 0), t3(1002, 0), t4(1003, 0);
+  // One at a time: the subscriber queue is short, and a cloud dropped by the queue is not a rejection.
   auto no_z = wallCloud(t2);
   no_z->fields.erase(no_z->fields.begin() + 2);
   probe.publish(no_z);
+  EXPECT_TRUE(waitFor([&] { return probe.rejected() == 1; })) << "clouds rejected = " << probe.rejected();
   auto short_data = wallCloud(t3);
   short_data->data.resize(short_data->data.size() - 1);
   probe.publish(short_data);
+  EXPECT_TRUE(waitFor([&] { return probe.rejected() == 2; })) << "clouds rejected = " << probe.rejected();
   // 3. The next good cloud is processed.
   probe.publish(wallCloud(t4));
   ASSERT_TRUE(waitFor([&] { return probe.grid(t4) != nullptr; })) << "no grid for the good cloud after the malformed ones";
