@@ -139,8 +139,8 @@ bool TruthObject::contains(core::Point2 p) const
   return std::abs(u) <= 0.5 * length && std::abs(v) <= 0.5 * width;
 }
 
-ObjectScorer::ObjectScorer(int min_visible_cells, double detection_window)
-  : min_visible_(min_visible_cells), window_(detection_window)
+ObjectScorer::ObjectScorer(int min_visible_cells, double detection_window, double hidden_window)
+  : min_visible_(min_visible_cells), window_(detection_window), hidden_window_(hidden_window)
 {
 }
 
@@ -163,18 +163,32 @@ void ObjectScorer::add(double stamp, const ClassGrid& truth, const std::vector<T
     const double r = 0.5 * std::hypot(o.length, o.width);
     const core::CellIndex lo = g.cellAt(core::Point2{ o.centre.x - r, o.centre.y - r });
     const core::CellIndex hi = g.cellAt(core::Point2{ o.centre.x + r, o.centre.y + r });
-    int visible = 0, as_moving = 0, as_stopped = 0;
+    int visible = 0, as_moving = 0, as_stopped = 0, footprint = 0, footprint_stopped = 0;
     for (int y = std::max(0, lo.y); y <= std::min(g.height - 1, hi.y); ++y)
       for (int x = std::max(0, lo.x); x <= std::min(g.width - 1, hi.x); ++x)
       {
         const core::Point2 p = g.cellCentre(core::CellIndex{ x, y });
-        if (!o.contains(p) || truth.cells[g.index(x, y)] != cls) continue;
-        ++visible;
+        if (!o.contains(p)) continue;
         const int d = decision.at(p);
+        ++footprint;
+        footprint_stopped += d == kStopped;
+        if (truth.cells[g.index(x, y)] != cls) continue;
+        ++visible;
         as_moving += d == kMoving;
         as_stopped += d == kStopped;
       }
-    if (visible < min_visible_) continue;
+    if (visible < min_visible_)
+    {
+      auto last = stopped_last_visible_.find(o.id);
+      if (cls == kStopped && footprint > 0 && last != stopped_last_visible_.end() &&
+          stamp - last->second <= hidden_window_)
+      {
+        ++hidden_pairs_;
+        hidden_kept_ += 2 * footprint_stopped > footprint;
+      }
+      continue;
+    }
+    if (cls == kStopped) stopped_last_visible_[o.id] = stamp;
     if (cls == kMoving)
     {
       Track& t = moving_[o.id];
@@ -214,6 +228,7 @@ double ObjectScorer::meanDetectionDelay() const
 
 double ObjectScorer::stoppedCalledMoving() const { return ratio(stopped_moving_, stopped_pairs_); }
 double ObjectScorer::stoppedRecognised() const { return ratio(stopped_stopped_, stopped_pairs_); }
+double ObjectScorer::stoppedKeptWhileHidden() const { return ratio(hidden_kept_, hidden_pairs_); }
 double ObjectScorer::trailCellsPerScan() const { return ratio(trail_cells_, scans_); }
 double ObjectScorer::trailFraction() const { return ratio(trail_cells_, free_cells_); }
 
@@ -237,6 +252,8 @@ std::map<std::string, double> flatten(const VariantScores& v)
   m["objects.moving.mean_detection_delay_s"] = v.objects.meanDetectionDelay();
   m["objects.stopped.called_moving_rate"] = v.objects.stoppedCalledMoving();
   m["objects.stopped.recognised_rate"] = v.objects.stoppedRecognised();
+  m["objects.stopped.hidden_scans"] = static_cast<double>(v.objects.stoppedHiddenPairs());
+  m["objects.stopped.kept_while_hidden_rate"] = v.objects.stoppedKeptWhileHidden();
   m["moving.trail_cells_per_scan"] = v.objects.trailCellsPerScan();
   m["moving.trail_fraction_of_free"] = v.objects.trailFraction();
   m["scans"] = static_cast<double>(v.scans);

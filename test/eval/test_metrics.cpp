@@ -93,6 +93,32 @@ TEST(ObjectScorer, DetectionDelayStoppedAndTrails)
   EXPECT_DOUBLE_EQ(s.trailFraction(), 1.0 / 8.0);
 }
 
+TEST(ObjectScorer, StoppedObjectKeptWhileHidden)
+{
+  ObjectScorer s(3, 1.0, 3.0);
+  TruthObject bus;
+  bus.id = 3;
+  bus.cell_class = CellClass::kStopped;
+  bus.centre = core::Point2{ 2.0, 1.0 };
+  bus.length = 4.0;
+  bus.width = 2.0;
+  auto seen = grid(10, 2, 0);
+  for (int x = 0; x < 4; ++x)
+    for (int y = 0; y < 2; ++y) seen.cells[seen.geometry.index(x, y)] = 3;
+  auto hidden = grid(10, 2, -1);  // nothing observed: the bus is occluded
+  auto decided = grid(10, 2, 0);
+  for (int x = 0; x < 4; ++x)
+    for (int y = 0; y < 2; ++y) decided.cells[decided.geometry.index(x, y)] = 3;
+  const auto forgotten = grid(10, 2, -1);
+  s.add(0.0, hidden, { bus }, decided);     // never seen yet: not counted
+  s.add(1.0, seen, { bus }, decided);       // visible
+  s.add(2.0, hidden, { bus }, decided);     // hidden 1 s later, still S: kept
+  s.add(3.0, hidden, { bus }, forgotten);   // hidden 2 s later, forgotten
+  s.add(5.0, hidden, { bus }, decided);     // hidden 4 s later: beyond the window, not counted
+  EXPECT_EQ(s.stoppedHiddenPairs(), 2u);
+  EXPECT_DOUBLE_EQ(s.stoppedKeptWhileHidden(), 0.5);
+}
+
 TEST(Reports, JsonAndMarkdownCarryTheNamedMetrics)
 {
   VariantScores v;

@@ -89,7 +89,7 @@ public:
    * @param detection_window   a moving object counts as detected when the majority of its visible cells are
    *                           decided V within this many seconds of first becoming visible
    */
-  explicit ObjectScorer(int min_visible_cells = 3, double detection_window = 1.0);
+  explicit ObjectScorer(int min_visible_cells = 3, double detection_window = 1.0, double hidden_window = 3.0);
 
   /// One scan: ground truth classes and objects, the decision grid.
   void add(double stamp, const ClassGrid& truth, const std::vector<TruthObject>& objects, const ClassGrid& decision);
@@ -104,6 +104,14 @@ public:
   double stoppedCalledMoving() const;
   /// Fraction of (stopped object, scan) pairs, where visible, whose majority of cells is decided S.
   double stoppedRecognised() const;
+  /**
+   * @brief Of the (stopped object, scan) pairs where the object is hidden (fewer than min_visible_cells observed)
+   *        but was visible less than @p hidden_window seconds ago, the fraction whose footprint is still mostly
+   *        decided S: "the parked bus is still in evidence despite being occluded".
+   */
+  double stoppedKeptWhileHidden() const;
+  /// Number of such (hidden stopped object, scan) pairs.
+  std::uint64_t stoppedHiddenPairs() const { return hidden_pairs_; }
   /// Cells decided V where the ground truth is free, per scan (V trails left behind movers).
   double trailCellsPerScan() const;
   /// Fraction of observed free cells decided V.
@@ -117,7 +125,10 @@ private:
   };
   int min_visible_;
   double window_;
+  double hidden_window_;
   std::map<std::uint32_t, Track> moving_;
+  std::map<std::uint32_t, double> stopped_last_visible_;
+  std::uint64_t hidden_pairs_ = 0, hidden_kept_ = 0;
   std::uint64_t stopped_pairs_ = 0, stopped_moving_ = 0, stopped_stopped_ = 0;
   std::uint64_t scans_ = 0, trail_cells_ = 0, free_cells_ = 0;
 };
