@@ -116,6 +116,15 @@ void ScanGridWorker::reject(const std::string& reason, const std::string& detail
     ROS_DEBUG("scan_grid: rejected a cloud (%s): %s", reason.c_str(), detail.c_str());
 }
 
+bool ScanGridWorker::viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCloudView& view)
+{
+  std::string detail;
+  const CloudRejection r = makePointCloudView(cloud, view, &detail);
+  if (r == CloudRejection::kNone) return true;
+  reject(toString(r), detail);
+  return false;
+}
+
 void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
   {
@@ -123,13 +132,7 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
     ++counters_.clouds_received;
     ++window_clouds_;
     core::PointCloudView view;
-    std::string detail;
-    const CloudRejection r = makePointCloudView(*cloud, view, &detail);
-    if (r != CloudRejection::kNone)
-    {
-      reject(toString(r), detail);
-      return;
-    }
+    if (!viewOf(*cloud, view)) return;
     if (cloud->header.frame_id.empty())
     {
       reject("no_frame_id", "header.frame_id is empty");
@@ -178,13 +181,7 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
     return;
   }
   core::PointCloudView view;
-  std::string detail;
-  const CloudRejection r = makePointCloudView(*cloud, view, &detail);
-  if (r != CloudRejection::kNone)
-  {
-    reject(toString(r), detail);
-    return;
-  }
+  if (!viewOf(*cloud, view)) return;
   if (!builder_.build(view, grid_, &last_stats_))
   {
     reject("layout", "the point view is inconsistent");
