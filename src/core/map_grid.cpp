@@ -90,8 +90,7 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
           const std::size_t j = row + static_cast<std::size_t>(x);
           if (fx >= 0.0 && fy >= 0.0 && fx < sw_max && fy < sh_max)
           {
-            const std::size_t i =
-                static_cast<std::size_t>(fy) * static_cast<std::size_t>(sg.width) + static_cast<std::size_t>(fx);
+            const std::size_t i = static_cast<std::size_t>(static_cast<int>(fy) * sg.width + static_cast<int>(fx));
             df[j] = sf[i];
             d_o[j] = s_o[i];
             dw[j] = sw[i];
