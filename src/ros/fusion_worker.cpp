@@ -79,12 +79,6 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 FusionWorker::~FusionWorker() = default;
 
-FusionCounters FusionWorker::counters() const
-{
-  std::lock_guard<std::mutex> lock(mutex_);
-  return counters_;
-}
-
 void FusionWorker::onReconfigure(FusionConfig& c, uint32_t)
 {
   std::lock_guard<std::mutex> lock(mutex_);

@@ -316,29 +316,28 @@ int main(int argc, char** argv)
     if (truth.empty()) throw std::runtime_error(opt.bag + " has no /ground_truth/classes");
 
     std::vector<std::unique_ptr<Variant>> variants;
-    variants.push_back(std::make_unique<Variant>("full", "the paper's method: prior, contextual discounting, modified "
-                                                         "Yager rule, counter and specialisation",
-                                                 params, true));
-    core::MapGridParams p = params;
-    variants.push_back(std::make_unique<Variant>("no_prior", "as full, with a vacuous PriorGrid", params, false));
+    // A variant: the configured method with one change.
+    auto add = [&](const std::string& name, const std::string& description, bool prior, auto&& change) {
+      core::MapGridParams p = params;
+      change(p.fusion);
+      variants.push_back(std::make_unique<Variant>(name, description, p, prior));
+    };
+    auto same = [](core::FusionParams&) {};
+    add("full", "the paper's method: prior, contextual discounting, modified Yager rule, counter and specialisation",
+        true, same);
+    add("no_prior", "as full, with a vacuous PriorGrid", false, same);
     if (opt.ablations)
     {
-      p = params;
-      p.fusion.rule = core::CombinationRule::kDempster;
-      variants.push_back(std::make_unique<Variant>("dempster", "Dempster's rule instead of the modified Yager rule", p, true));
-      p = params;
-      p.fusion.rule = core::CombinationRule::kYager;
-      variants.push_back(std::make_unique<Variant>("yager", "Yager's rule (all conflict to Omega) instead of the modified "
-                                                            "Yager rule",
-                                                   p, true));
-      p = params;
-      p.fusion.contextual_discounting = false;
-      p.fusion.alpha_single = params.fusion.discount.alpha_free;
-      variants.push_back(std::make_unique<Variant>(
-          "single_rate", "classical discounting with one rate (alpha_free) instead of contextual discounting", p, true));
-      p = params;
-      p.fusion.use_counter = false;
-      variants.push_back(std::make_unique<Variant>("no_counter", "no counter zeta and no specialisation", p, true));
+      add("dempster", "Dempster's rule instead of the modified Yager rule", true,
+          [](core::FusionParams& f) { f.rule = core::CombinationRule::kDempster; });
+      add("yager", "Yager's rule (all conflict to Omega) instead of the modified Yager rule", true,
+          [](core::FusionParams& f) { f.rule = core::CombinationRule::kYager; });
+      add("single_rate", "classical discounting with one rate (alpha_free) instead of contextual discounting", true,
+          [](core::FusionParams& f) {
+            f.contextual_discounting = false;
+            f.alpha_single = f.discount.alpha_free;
+          });
+      add("no_counter", "no counter zeta and no specialisation", true, [](core::FusionParams& f) { f.use_counter = false; });
     }
 
     fs::create_directories(fs::path(opt.out) / "snapshots");

@@ -81,7 +81,6 @@ struct StageTimes
   double project_scan = 0.0;
   double prior_window = 0.0;
   double fusion = 0.0;
-  double total() const { return shift + project_scan + prior_window + fusion; }
 };
 
 /// An object made of a connected region of moving or stopped cells.
@@ -169,8 +168,6 @@ public:
   const GridGeometry& geometry() const { return grid_.geometry(); }
   /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
   const PignisticPlanes& pignistic() const { return betp_; }
-  /// The scan of the last update, in window cells.
-  const ScanMassGrid& lastScanInWindow() const { return scan_window_; }
   /// Number of scans fused since the last reset.
   std::size_t scans() const { return scans_; }
 

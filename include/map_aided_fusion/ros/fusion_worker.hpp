@@ -46,8 +46,6 @@ public:
   FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh);
   ~FusionWorker();
 
-  FusionCounters counters() const;
-
 private:
   void onScan(const EvidentialGrid::ConstPtr& msg);
   void onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason);
@@ -61,7 +59,7 @@ private:
   bool publish_free_cells_ = false;
   double object_box_height_ = 1.5;
 
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   core::MapGrid grid_;
   std::optional<core::MapGridParams> pending_params_;
   std::shared_ptr<core::PriorWindow> prior_;
