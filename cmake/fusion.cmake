@@ -21,6 +21,13 @@ if(CATKIN_ENABLE_TESTING)
 
   add_rostest_gtest(test_fusion_pipeline test/fusion_pipeline.test test/ros/test_fusion_pipeline.cpp)
   target_link_libraries(test_fusion_pipeline ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+
+  # Faults (wall time) and a looping replay (simulated time): one executable, two launch files.
+  add_rostest_gtest(test_faults test/faults.test test/ros/test_faults.cpp)
+  target_link_libraries(test_faults ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+  target_compile_definitions(test_faults PRIVATE MAF_FUSION_NODE="$<TARGET_FILE:fusion_node>")
+  add_dependencies(test_faults fusion_node map_aided_fusion_fusion_nodelet)
+  add_rostest(test/bag_loop.test DEPENDENCIES test_faults)
 endif()
 
 if(TARGET bench_map_aided_fusion)

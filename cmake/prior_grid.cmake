@@ -43,7 +43,7 @@ if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_prior_grid test/prior/test_prior_grid.cpp test/test_main.cpp)
   target_link_libraries(test_prior_grid map_aided_fusion_core)
 
-  catkin_add_gtest(test_map_loader test/prior/test_map_loader.cpp test/test_main.cpp)
+  catkin_add_gtest(test_map_loader test/prior/test_map_loader.cpp test/prior/test_reader_faults.cpp test/test_main.cpp)
   target_link_libraries(test_map_loader map_aided_fusion_map_io ${GeographicLib_LIBRARIES} ${GDAL_LIBRARIES})
   target_include_directories(test_map_loader SYSTEM PRIVATE ${GeographicLib_INCLUDE_DIRS} ${GDAL_INCLUDE_DIRS})
   target_compile_definitions(test_map_loader PRIVATE

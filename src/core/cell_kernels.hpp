@@ -354,6 +354,29 @@ MAF_INLINE void pignistic(const T (&m)[kSubsets], T (&p)[FrameMG::kSize])
   for (int e = 0; e < FrameMG::kSize; ++e) p[e] = p[e] * inv + uniform;
 }
 
+/**
+ * Rounding hygiene once per step: negative masses (float rounding, ~1e-8) are set to 0 and the cell is
+ * divided by its sum, so that 10^5 steps do not drift from a mass function. A cell whose sum is not
+ * positive (never reached by the rules) becomes vacuous.
+ */
+template <typename T>
+MAF_INLINE void renormalise(T (&m)[kSubsets])
+{
+  const T zero{}, one = splat<T>(1.0f);
+  T sum = zero;
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a)
+  {
+    m[a] = select(m[a] > zero, m[a], zero);
+    sum += m[a];
+  }
+  const auto empty = sum <= zero;
+  const T inv = select(empty, zero, one / sum);
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a) m[a] *= inv;
+  m[kSubsets - 1] += select(empty, one, zero);
+}
+
 /// Mass on the non-empty subsets of {C, N, S, V}.
 template <typename T>
 MAF_INLINE T occupiedMass(const T (&m)[kSubsets])

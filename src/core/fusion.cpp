@@ -91,6 +91,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       kernels::store(zeta + i, z);
       kernels::specialise(m, z, in.literal);
     }
+    kernels::renormalise(m);
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
     if (in.betp[0])

@@ -17,6 +17,10 @@ namespace {
 constexpr int kMaxWindowCells = 8192;
 /// Side of the square tiles projectScan() walks the window in, cells.
 constexpr int kProjectTile = 32;
+/// Bounds of memory_budget_mb, MiB.
+constexpr double kMinBudgetMb = 1.0;
+constexpr double kMaxBudgetMb = 1048576.0;
+constexpr double kBytesPerMb = 1048576.0;
 /// m(Ω) at or above 1 − this is a vacuous cell.
 constexpr float kVacuousTolerance = 1e-3f;
 
@@ -51,10 +55,33 @@ void MapGridParams::validate() const
     throw ParameterError("size_y", "more than " + std::to_string(kMaxWindowCells) + " cells at this resolution");
   if (std::lround(size_x / resolution) < 1) throw ParameterError("size_x", "smaller than one cell");
   if (std::lround(size_y / resolution) < 1) throw ParameterError("size_y", "smaller than one cell");
+  requireInRange("memory_budget_mb", memory_budget_mb, kMinBudgetMb, kMaxBudgetMb);
+  const double needed = bytesNeeded();
+  if (needed > memory_budget_mb * kBytesPerMb)
+    throw ParameterError("size_x", "a window of " + std::to_string(std::lround(size_x / resolution)) + " x " +
+                                       std::to_string(std::lround(size_y / resolution)) + " cells needs " +
+                                       std::to_string(static_cast<long long>(needed)) + " bytes (" +
+                                       std::to_string(bytesPerCell()) + " per cell), more than memory_budget_mb = " +
+                                       std::to_string(memory_budget_mb) + " MiB; reduce size_x/size_y, raise "
+                                       "resolution or raise memory_budget_mb");
   requireInRange("recentre_distance", recentre_distance, 0.0, 0.5 * std::min(size_x, size_y));
   requireUnit("decision_threshold", decision_threshold);
   if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
   fusion.validate();
+}
+
+std::size_t MapGridParams::bytesPerCell()
+{
+  const std::size_t planes = (FrameMG::kNumSubsets + 1)   // masses and ζ
+                             + FrameMG::kSize              // BetP
+                             + FrameSG::kNumSubsets        // the scan projected into the window
+                             + 3;                          // the prior window (building, road, other)
+  return planes * sizeof(float) + sizeof(std::int8_t);     // and the decision
+}
+
+double MapGridParams::bytesNeeded() const
+{
+  return std::round(size_x / resolution) * std::round(size_y / resolution) * static_cast<double>(bytesPerCell());
 }
 
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)

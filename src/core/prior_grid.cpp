@@ -56,39 +56,48 @@ void ScanlineRasterizer::addRing(const Ring& ring)
     const long r0 = firstCentreAtOrAbove(ylo, oy, res, geometry_.height);
     const long r1 = firstCentreAtOrAbove(yhi, oy, res, geometry_.height);
     if (r0 >= r1) continue;
-    const double slope = (b.x - a.x) / (b.y - a.y);
-    for (long r = r0; r < r1; ++r)
-    {
-      const double yc = oy + (static_cast<double>(r) + 0.5) * res;
-      crossings_.emplace_back(static_cast<int>(r), a.x + (yc - a.y) * slope);
-    }
+    edges_.push_back(Edge{ r0, r1, a.x, a.y, (b.x - a.x) / (b.y - a.y) });
   }
 }
 
 void ScanlineRasterizer::fill(const std::vector<const Ring*>& rings, std::vector<CellSpan>& spans)
 {
   spans.clear();
-  crossings_.clear();
+  edges_.clear();
+  active_.clear();
   for (const Ring* r : rings)
     if (r == nullptr || !finiteRing(*r)) return;
   for (const Ring* r : rings) addRing(*r);
-  std::sort(crossings_.begin(), crossings_.end());
+  if (edges_.empty()) return;
+  std::sort(edges_.begin(), edges_.end(), [](const Edge& a, const Edge& b) { return a.row_begin < b.row_begin; });
+  long last_row = 0;
+  for (const Edge& e : edges_) last_row = std::max(last_row, e.row_end);
   const double res = geometry_.resolution;
   const double ox = geometry_.origin_x;
+  const double oy = geometry_.origin_y;
   const long w = geometry_.width;
-  std::size_t i = 0;
-  while (i < crossings_.size())
+  std::size_t next = 0;
+  for (long row = edges_.front().row_begin; row < last_row; ++row)
   {
-    std::size_t j = i;
-    while (j < crossings_.size() && crossings_[j].first == crossings_[i].first) ++j;
-    // Within a row the number of crossings is even (half-open rule on closed rings).
-    for (std::size_t k = i; k + 1 < j; k += 2)
+    while (next < edges_.size() && edges_[next].row_begin == row) active_.push_back(next++);
+    active_.erase(std::remove_if(active_.begin(), active_.end(), [&](std::size_t k) { return edges_[k].row_end <= row; }),
+                  active_.end());
+    if (active_.empty())
     {
-      const long c0 = firstCentreAtOrAbove(crossings_[k].second, ox, res, w);
-      const long c1 = firstCentreAtOrAbove(crossings_[k + 1].second, ox, res, w);
-      if (c0 < c1) spans.push_back(CellSpan{ crossings_[i].first, static_cast<int>(c0), static_cast<int>(c1) });
+      if (next < edges_.size()) row = edges_[next].row_begin - 1;
+      continue;
     }
-    i = j;
+    const double yc = oy + (static_cast<double>(row) + 0.5) * res;
+    row_x_.clear();
+    for (std::size_t k : active_) row_x_.push_back(edges_[k].ax + (yc - edges_[k].ay) * edges_[k].slope);
+    std::sort(row_x_.begin(), row_x_.end());
+    // Within a row the number of crossings is even (half-open rule on closed rings).
+    for (std::size_t k = 0; k + 1 < row_x_.size(); k += 2)
+    {
+      const long c0 = firstCentreAtOrAbove(row_x_[k], ox, res, w);
+      const long c1 = firstCentreAtOrAbove(row_x_[k + 1], ox, res, w);
+      if (c0 < c1) spans.push_back(CellSpan{ static_cast<int>(row), static_cast<int>(c0), static_cast<int>(c1) });
+    }
   }
 }
 

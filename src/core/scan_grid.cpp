@@ -16,6 +16,11 @@ constexpr double kFullTurnDeg = 360.0;
 constexpr double kMinAzimuthResolutionDeg = 0.01;
 constexpr double kMaxAzimuthResolutionDeg = 45.0;
 constexpr double kSectorCountSlack = 1e-9;     // 360 / 0.25 is 1440 sectors, not 1441
+/// Bounds that keep every cell index, range and angle far inside float and int: a vehicle-frame grid,
+/// ranges and heights of at most 10 km, a sensor at most 1 km from base_link.
+constexpr double kMaxExtent = 10000.0;       // m
+constexpr double kMinGridResolution = 0.01;  // m
+constexpr double kMaxSensorOffset = 1000.0;  // m
 constexpr double kSensorMoveTolerance = 1e-3;  // m; a smaller (x, y) change keeps the table
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kHalfPi = 0.5f * kPi;
@@ -61,34 +66,29 @@ inline float readFloat(const std::uint8_t* p)
 
 void ScanGridParams::validate() const
 {
-  requirePositive("grid_resolution", grid_resolution);
-  requireInRange("grid_size_x", grid_size_x, grid_resolution, std::numeric_limits<double>::max());
-  requireInRange("grid_size_y", grid_size_y, grid_resolution, std::numeric_limits<double>::max());
-  requireInRange("grid_offset_x", grid_offset_x, -std::numeric_limits<double>::max(),
-                 std::numeric_limits<double>::max());
-  requireInRange("grid_offset_y", grid_offset_y, -std::numeric_limits<double>::max(),
-                 std::numeric_limits<double>::max());
+  requireInRange("grid_resolution", grid_resolution, kMinGridResolution, kMaxExtent);
+  requireInRange("grid_size_x", grid_size_x, grid_resolution, kMaxExtent);
+  requireInRange("grid_size_y", grid_size_y, grid_resolution, kMaxExtent);
+  requireInRange("grid_offset_x", grid_offset_x, -kMaxExtent, kMaxExtent);
+  requireInRange("grid_offset_y", grid_offset_y, -kMaxExtent, kMaxExtent);
   requireInRange("azimuth_resolution_deg", azimuth_resolution_deg, kMinAzimuthResolutionDeg,
                  kMaxAzimuthResolutionDeg);
-  requireInRange("min_range", min_range, 0.0, std::numeric_limits<double>::max());
-  requirePositive("max_range", max_range);
+  requireInRange("min_range", min_range, 0.0, kMaxExtent);
+  requireInRange("max_range", max_range, std::numeric_limits<double>::min(), kMaxExtent);
   if (!(max_range > min_range)) throw ParameterError("max_range", "must be > min_range");
-  const double big = std::numeric_limits<double>::max();
-  requireInRange("self_box_min_x", self_box_min_x, -big, big);
-  requireInRange("self_box_max_x", self_box_max_x, self_box_min_x, big);
-  requireInRange("self_box_min_y", self_box_min_y, -big, big);
-  requireInRange("self_box_max_y", self_box_max_y, self_box_min_y, big);
-  requireInRange("ground_height", ground_height, -std::numeric_limits<double>::max(),
-                 std::numeric_limits<double>::max());
-  requireInRange("ground_tolerance", ground_tolerance, 0.0, std::numeric_limits<double>::max());
-  requireInRange("obstacle_min_height", obstacle_min_height, ground_tolerance, std::numeric_limits<double>::max());
-  requireInRange("obstacle_max_height", obstacle_max_height, obstacle_min_height,
-                 std::numeric_limits<double>::max());
+  requireInRange("self_box_min_x", self_box_min_x, -kMaxExtent, kMaxExtent);
+  requireInRange("self_box_max_x", self_box_max_x, self_box_min_x, kMaxExtent);
+  requireInRange("self_box_min_y", self_box_min_y, -kMaxExtent, kMaxExtent);
+  requireInRange("self_box_max_y", self_box_max_y, self_box_min_y, kMaxExtent);
+  requireInRange("ground_height", ground_height, -kMaxExtent, kMaxExtent);
+  requireInRange("ground_tolerance", ground_tolerance, 0.0, kMaxExtent);
+  requireInRange("obstacle_min_height", obstacle_min_height, ground_tolerance, kMaxExtent);
+  requireInRange("obstacle_max_height", obstacle_max_height, obstacle_min_height, kMaxExtent);
   if (!(obstacle_max_height > obstacle_min_height))
     throw ParameterError("obstacle_max_height", "must be > obstacle_min_height");
   requireUnit("mu_free", mu_free);
   requireUnit("mu_occupied", mu_occupied);
-  requireInRange("free_decay_length", free_decay_length, 0.0, std::numeric_limits<double>::max());
+  requireInRange("free_decay_length", free_decay_length, 0.0, kMaxExtent);
   requireInRange("free_margin", free_margin, 0.0, max_range);
   const double cells = std::round(grid_size_x / grid_resolution) * std::round(grid_size_y / grid_resolution);
   if (!(cells <= static_cast<double>(kScanGridMaxCells)))
@@ -133,6 +133,9 @@ void ScanGridBuilder::configure(const ScanGridParams& params, const Eigen::Isome
   geometry.validate();
   if (!sensor_pose.matrix().allFinite())
     throw ParameterError("sensor_pose", "the sensor → base_link transform is not finite");
+  if (sensor_pose.translation().cwiseAbs().maxCoeff() > kMaxSensorOffset)
+    throw ParameterError("sensor_pose", "the sensor is more than " + std::to_string(kMaxSensorOffset) +
+                                            " m from base_link");
 
   const bool same_table = configured_ && geometry == geometry_ &&
                           params.azimuth_resolution_deg == params_.azimuth_resolution_deg &&

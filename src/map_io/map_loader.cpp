@@ -38,6 +38,16 @@ constexpr double kMaxLongitude = 180.0;
 constexpr double kMetresPerKilometre = 1000.0;
 /// Vertices closer than this (map units) are merged.
 constexpr double kDuplicateVertexTolerance = 1e-9;
+/// Source coordinates beyond this magnitude are no place on Earth in any CRS (metres, feet or degrees);
+/// PROJ can loop for a long time on them, so they never reach the transformation.
+constexpr double kMaxSourceCoordinate = 1e9;
+/// Bounds of origin_altitude, metres above the ellipsoid (deepest dry land to above the highest summit).
+constexpr double kMinOriginAltitude = -1000.0;
+constexpr double kMaxOriginAltitude = 10000.0;
+/// Bounds of max_vertices_per_feature.
+constexpr double kMinVerticesPerFeature = 3.0;
+constexpr double kMaxVerticesPerFeature = 1e8;
+constexpr double kFullTurnDegrees = 360.0;
 
 using core::Point2;
 using Ring = std::vector<Point2>;
@@ -401,6 +411,65 @@ private:
     return Role::kNone;
   }
 
+  /// Number of vertices of a geometry (all rings and parts).
+  static std::size_t vertexCount(const OGRGeometry* g)
+  {
+    const OGRwkbGeometryType t = wkbFlatten(g->getGeometryType());
+    if (t == wkbPolygon)
+    {
+      const OGRPolygon* p = g->toPolygon();
+      std::size_t n = p->getExteriorRing() ? static_cast<std::size_t>(p->getExteriorRing()->getNumPoints()) : 0;
+      for (int k = 0; k < p->getNumInteriorRings(); ++k)
+        n += static_cast<std::size_t>(p->getInteriorRing(k)->getNumPoints());
+      return n;
+    }
+    if (t == wkbLineString || t == wkbLinearRing) return static_cast<std::size_t>(g->toLineString()->getNumPoints());
+    if (OGR_GT_IsSubClassOf(t, wkbGeometryCollection))
+    {
+      std::size_t n = 0;
+      for (const OGRGeometry* part : *g->toGeometryCollection()) n += vertexCount(part);
+      return n;
+    }
+    if (OGR_GT_IsCurve(t)) return static_cast<std::size_t>(g->toSimpleCurve() ? g->toSimpleCurve()->getNumPoints() : 0);
+    return 0;
+  }
+
+  /// True when every coordinate of @p g is finite and within kMaxSourceCoordinate.
+  static bool coordinatesInRange(const OGRGeometry* g)
+  {
+    OGREnvelope env;
+    g->getEnvelope(&env);
+    for (const double v : { env.MinX, env.MaxX, env.MinY, env.MaxY })
+      if (!std::isfinite(v) || std::abs(v) > kMaxSourceCoordinate) return false;
+    return true;
+  }
+
+  /// A copy of @p poly without the holes that are disjoint from its shell or enclose it (they would be
+  /// "repaired" into extra polygons); @p dropped counts them.
+  static std::unique_ptr<OGRPolygon> withoutStrayHoles(const OGRPolygon& poly, std::size_t& dropped)
+  {
+    auto out = std::make_unique<OGRPolygon>();
+    const OGRLinearRing* ext = poly.getExteriorRing();
+    if (ext == nullptr) return out;
+    // addRing() copies the ring; the const_casts only meet its older signature.
+    out->addRing(const_cast<OGRLinearRing*>(ext));
+    if (poly.getNumInteriorRings() == 0) return out;
+    OGRPolygon shell;
+    shell.addRing(const_cast<OGRLinearRing*>(ext));
+    for (int k = 0; k < poly.getNumInteriorRings(); ++k)
+    {
+      OGRPolygon hole;
+      hole.addRing(const_cast<OGRLinearRing*>(poly.getInteriorRing(k)));
+      if (!shell.Intersects(&hole) || hole.Contains(&shell))
+      {
+        ++dropped;
+        continue;
+      }
+      out->addRing(const_cast<OGRLinearRing*>(poly.getInteriorRing(k)));
+    }
+    return out;
+  }
+
   /// Appends the vertices of a ring (closing vertex and duplicates removed); false when degenerate.
   static bool ringPoints(const OGRLinearRing& ring, Ring& out)
   {
@@ -440,11 +509,23 @@ private:
       if (!linear) return skipDegenerate(id, "curved geometry could not be linearised");
       geometry = linear.get();
     }
+    std::vector<const OGRPolygon*> parts;
+    collectPolygons(geometry, parts);
+    if (parts.empty()) return skipDegenerate(id, "no polygon in the geometry");
+    // Holes outside their shell or around it are dropped first: repairing them would invent polygons.
+    OGRMultiPolygon cleaned;
+    std::size_t dropped = 0;
+    for (const OGRPolygon* part : parts) cleaned.addGeometryDirectly(withoutStrayHoles(*part, dropped).release());
+    if (dropped > 0)
+    {
+      r_.dropped_holes += dropped;
+      note(id, std::to_string(dropped) + " hole(s) outside their shell or enclosing it dropped");
+    }
     std::unique_ptr<OGRGeometry> repaired;
     std::vector<const OGRPolygon*> polygons;
-    if (p_.repair_invalid && !geometry->IsValid())
+    if (p_.repair_invalid && !cleaned.IsValid())
     {
-      repaired.reset(geometry->MakeValid());
+      repaired.reset(cleaned.MakeValid());
       if (repaired && !repaired->IsEmpty() && repaired->IsValid()) collectPolygons(repaired.get(), polygons);
       if (polygons.empty())
       {
@@ -455,7 +536,7 @@ private:
       ++r_.repaired_geometries;
     }
     else
-      collectPolygons(geometry, polygons);
+      collectPolygons(&cleaned, polygons);
     if (polygons.empty()) return skipDegenerate(id, "no polygon in the geometry");
     bool any = false;
     for (const OGRPolygon* poly : polygons)
@@ -595,6 +676,18 @@ private:
         note(id, "nodes missing from the extract");
         continue;
       }
+      if (!coordinatesInRange(g))
+      {
+        skipDegenerate(id, "coordinates not finite or beyond 1e9 in the source CRS");
+        continue;
+      }
+      if (vertexCount(g) > static_cast<std::size_t>(p_.max_vertices_per_feature))
+      {
+        ++r_.skipped_too_many_vertices;
+        note(id, std::to_string(vertexCount(g)) + " vertices, more than max_vertices_per_feature = " +
+                     std::to_string(p_.max_vertices_per_feature));
+        continue;
+      }
       if (OGRCoordinateTransformation* ct = transformFor(layer))
       {
         if (g->transform(ct) != OGRERR_NONE)
@@ -680,9 +773,31 @@ private:
       {
         lat0 = 0.5 * (min_lat + max_lat);
         lon0 = 0.5 * (min_lon + max_lon);
+        if (max_lon - min_lon > 0.5 * kFullTurnDegrees)
+        {
+          // Data across the antimeridian: the centre of the longitudes east of it, taken modulo 360.
+          double lo = 1e300, hi = -1e300;
+          forEachPoint([&](Point2& q) {
+            const double l = q.x < 0.0 ? q.x + kFullTurnDegrees : q.x;
+            lo = std::min(lo, l);
+            hi = std::max(hi, l);
+          });
+          lon0 = 0.5 * (lo + hi);
+          if (lon0 > kMaxLongitude) lon0 -= kFullTurnDegrees;
+        }
       }
       const LocalProjector proj(lat0, lon0, p_.origin_altitude);
-      forEachPoint([&](Point2& q) { q = proj.forward(q.y, q.x); });
+      // A point far round the globe projects near the origin on the tangent plane (the antipode onto the
+      // origin itself): a vertex whose straight-line distance is beyond max_origin_distance while its
+      // horizontal distance is less than half of that is on the far side; it becomes NaN and its feature
+      // is dropped as out of range below.
+      forEachPoint([&](Point2& q) {
+        double up = 0.0;
+        const Point2 e = proj.forward(q.y, q.x, &up);
+        const double horizontal = std::hypot(e.x, e.y);
+        const double chord = std::hypot(horizontal, up);
+        q = chord > p_.max_origin_distance && horizontal < 0.5 * chord ? Point2{ std::nan(""), std::nan("") } : e;
+      });
     }
     r_.origin_latitude = p_.metric ? 0.0 : lat0;
     r_.origin_longitude = p_.metric ? 0.0 : lon0;
@@ -691,12 +806,16 @@ private:
     const double max_d2 = p_.max_origin_distance * p_.max_origin_distance;
     double nearest2 = 1e300;
     auto nearFeature = [&](const Ring& ring, bool& near) {
+      bool far_side = false;
       for (const auto& q : ring)
       {
         const double d2 = q.x * q.x + q.y * q.y;
+        far_side = far_side || !std::isfinite(d2);
+        if (!std::isfinite(d2)) continue;
         nearest2 = std::min(nearest2, d2);
         if (d2 <= max_d2) near = true;
       }
+      if (far_side) near = false;
     };
     auto dropFar = [&](const std::string& id) {
       ++r_.skipped_out_of_range;
@@ -758,7 +877,8 @@ private:
     r_.road_areas = out_.road_areas.size();
     r_.road_lines = out_.road_lines.size();
     r_.skipped_geometries = r_.skipped_unclosed + r_.skipped_missing_nodes + r_.skipped_incomplete_relations +
-                            r_.skipped_degenerate + r_.skipped_invalid + r_.skipped_out_of_range;
+                            r_.skipped_degenerate + r_.skipped_invalid + r_.skipped_out_of_range +
+                            r_.skipped_too_many_vertices;
     out_.skipped_geometries = r_.skipped_geometries;
   }
 
@@ -821,13 +941,21 @@ void MapLoadParams::validate() const
   if (file.empty()) throw core::ParameterError("map_file", "no map file given");
   if (!metric)
   {
+    for (const auto& [name, value] : { std::pair<const char*, double>{ "origin_latitude", origin_latitude },
+                                       std::pair<const char*, double>{ "origin_longitude", origin_longitude } })
+      if (std::isinf(value)) throw core::ParameterError(name, "must be finite degrees (NaN, or absent: automatic)");
     const bool auto_lat = std::isnan(origin_latitude), auto_lon = std::isnan(origin_longitude);
     if (auto_lat != auto_lon)
-      throw core::ParameterError("origin_latitude", "give both origin_latitude and origin_longitude, or neither");
+      throw core::ParameterError(auto_lat ? "origin_latitude" : "origin_longitude",
+                                 std::string("is NaN (automatic) but ") +
+                                     (auto_lat ? "origin_longitude" : "origin_latitude") +
+                                     " is set: give both origin_latitude and origin_longitude, or neither");
     if (!auto_lat) core::requireInRange("origin_latitude", origin_latitude, -kMaxLatitude, kMaxLatitude);
     if (!auto_lon) core::requireInRange("origin_longitude", origin_longitude, -kMaxLongitude, kMaxLongitude);
   }
-  if (!std::isfinite(origin_altitude)) throw core::ParameterError("origin_altitude", "must be finite");
+  core::requireInRange("origin_altitude", origin_altitude, kMinOriginAltitude, kMaxOriginAltitude);
+  core::requireInRange("max_vertices_per_feature", static_cast<double>(max_vertices_per_feature),
+                       kMinVerticesPerFeature, kMaxVerticesPerFeature);
   core::requirePositive("max_origin_distance", max_origin_distance);
   core::requirePositive("lane_width", lane_width);
   core::requirePositive("level_height", level_height);
@@ -858,7 +986,8 @@ std::string summary(const MapLoadReport& r)
     << r.skipped_geometries << " (unclosed " << r.skipped_unclosed << ", missing nodes " << r.skipped_missing_nodes
     << ", incomplete relations " << r.skipped_incomplete_relations
     << ", degenerate " << r.skipped_degenerate << ", invalid " << r.skipped_invalid << ", out of range "
-    << r.skipped_out_of_range << ")";
+    << r.skipped_out_of_range << ", too many vertices " << r.skipped_too_many_vertices << "); holes dropped "
+    << r.dropped_holes;
   if (r.read_errors > 0) s << "; " << r.read_errors << " read errors: the map may be incomplete";
   return s.str();
 }

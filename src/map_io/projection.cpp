@@ -22,10 +22,11 @@ LocalProjector::~LocalProjector() = default;
 LocalProjector::LocalProjector(LocalProjector&&) noexcept = default;
 LocalProjector& LocalProjector::operator=(LocalProjector&&) noexcept = default;
 
-core::Point2 LocalProjector::forward(double latitude, double longitude) const
+core::Point2 LocalProjector::forward(double latitude, double longitude, double* up) const
 {
   double x = 0.0, y = 0.0, z = 0.0;
   impl_->lc.Forward(latitude, longitude, altitude_, x, y, z);
+  if (up) *up = z;
   return core::Point2{ x, y };
 }
 

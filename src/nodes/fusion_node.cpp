@@ -1,4 +1,6 @@
 // The fusion as a plain node: the same worker as FusionNodelet.
+#include <iostream>
+
 #include <ros/ros.h>
 
 #include "map_aided_fusion/ros/fusion_worker.hpp"
@@ -13,7 +15,9 @@ int main(int argc, char** argv)
   }
   catch (const std::exception& e)
   {
-    ROS_FATAL_STREAM("fusion: " << e.what());
+    // On stderr as well as rosout: rosconsole may not be flushed before exit.
+    std::cerr << "fusion: not started: " << e.what() << std::endl;
+    ROS_FATAL_STREAM("fusion: not started: " << e.what());
     return 1;
   }
   return 0;

@@ -1,6 +1,8 @@
 #include "map_aided_fusion/ros/fusion_worker.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <sstream>
 
 #include <nav_msgs/OccupancyGrid.h>
 #include <tf2/utils.h>
@@ -14,10 +16,12 @@ namespace map_aided_fusion {
 
 namespace {
 
-constexpr int kQueueSize = 5;
-constexpr double kDiagnosticsPeriod = 1.0;
-/// Scans whose stamp goes back by more than this reset the grid.
-const ros::Duration kBackwardTolerance(0.001);
+constexpr int kMaxQueueSize = 1000;
+constexpr double kMaxFutureTolerance = 3600.0;
+constexpr double kMaxObjectBoxHeight = 100.0;
+/// Wall period of the clock watch (backward /clock jumps, transforms ahead of the clock), s.
+constexpr double kClockCheckPeriod = 0.1;
+constexpr double kWarnThrottle = 1.0;
 constexpr const char* kBetpTopics[core::FrameMG::kSize] = { "betp/free", "betp/building", "betp/infrastructure",
                                                              "betp/stopped", "betp/moving" };
 
@@ -37,52 +41,111 @@ std::string reasonName(tf2_ros::FilterFailureReason r)
 
 }  // namespace
 
+void FusionNodeParams::validate() const
+{
+  if (map_frame.empty()) throw core::ParameterError("map_frame", "must not be empty");
+  core::requireInRange("tf_queue_size", tf_queue_size, 1, kMaxQueueSize);
+  core::requireInRange("future_tolerance", future_tolerance, 0.0, kMaxFutureTolerance);
+  core::requireInRange("object_box_height", object_box_height, 1e-3, kMaxObjectBoxHeight);
+  time.validate();
+  health.validate();
+}
+
+FusionNodeParams FusionNodeParams::load(const ros::NodeHandle& pnh)
+{
+  FusionNodeParams p;
+  readParam(pnh, "map_frame", p.map_frame);
+  readParam(pnh, "base_frame", p.base_frame);
+  readParam(pnh, "tf_queue_size", p.tf_queue_size);
+  readParam(pnh, "future_tolerance", p.future_tolerance);
+  readParam(pnh, "publish_free_cells", p.publish_free_cells);
+  readParam(pnh, "object_box_height", p.object_box_height);
+  core::forEachParam(p.time, parameterServerReader(pnh));
+  core::forEachParam(p.health, parameterServerReader(pnh));
+  p.validate();
+  return p;
+}
+
 FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   : nh_(nh)
   , pnh_(pnh)
+  , node_params_(FusionNodeParams::load(pnh))
   , grid_(loadMapGridParams(pnh))
+  , stamp_guard_(node_params_.time)
+  , clock_jump_(node_params_.time.time_jump_threshold)
+  , fused_window_(node_params_.health.diagnostic_window)
+  , lost_window_(node_params_.health.diagnostic_window)
   , tf_listener_(tf_buffer_, nh)
   , reconfigure_(pnh)
 {
-  pnh_.param<std::string>("map_frame", map_frame_, "map");
-  pnh_.param<std::string>("base_frame", base_frame_, "base_link");
-  pnh_.param("publish_free_cells", publish_free_cells_, false);
-  readParam(pnh_, "object_box_height", object_box_height_);
-  int queue_size = kQueueSize;
-  readParam(pnh_, "tf_queue_size", queue_size);
-  core::requireInRange("tf_queue_size", queue_size, 1, 1000);
-
+  start_wall_ = wallNow();
   map_grid_pub_ = nh_.advertise<EvidentialGrid>("map_grid", 1);
   for (int e = 0; e < core::FrameMG::kSize; ++e) betp_pub_[e] = nh_.advertise<nav_msgs::OccupancyGrid>(kBetpTopics[e], 1);
   decision_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("decision", 1);
   cells_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("cells", 1);
   objects_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("objects", 1);
 
-  prior_sub_ = nh_.subscribe("prior_grid", 1, &FusionWorker::onPrior, this);
-  scan_sub_.subscribe(nh_, "scan_grid", static_cast<uint32_t>(queue_size));
-  scan_filter_ = std::make_unique<tf2_ros::MessageFilter<EvidentialGrid>>(
-      scan_sub_, tf_buffer_, map_frame_, static_cast<uint32_t>(queue_size), nh_);
+  const auto queue = static_cast<uint32_t>(node_params_.tf_queue_size);
+  scan_filter_ =
+      std::make_unique<tf2_ros::MessageFilter<EvidentialGrid>>(tf_buffer_, node_params_.map_frame, queue, nh_);
   scan_filter_->registerCallback(&FusionWorker::onScan, this);
   scan_filter_->registerFailureCallback(
       [this](const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason) { onScanDropped(msg, reason); });
+  prior_sub_ = nh_.subscribe("prior_grid", 1, &FusionWorker::onPrior, this);
+  scan_sub_ = nh_.subscribe("scan_grid", queue, &FusionWorker::onScanIn, this);
 
   reconfigure_.setCallback([this](FusionConfig& config, uint32_t level) { onReconfigure(config, level); });
 
-  diagnostics_.setHardwareID("map_aided_fusion");
-  diagnostics_.add("fusion", this, &FusionWorker::diagnose);
-  diagnostics_timer_ =
-      nh_.createTimer(ros::Duration(kDiagnosticsPeriod), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
+  diagnostics_->setHardwareID("map_aided_fusion");
+  diagnostics_->add("fusion", this, &FusionWorker::diagnose);
+  diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(node_params_.health.diagnostic_period),
+                                           [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
+  clock_timer_ =
+      nh_.createWallTimer(ros::WallDuration(kClockCheckPeriod), [this](const ros::WallTimerEvent&) { checkClock(); });
   ROS_INFO_STREAM("fusion: MapGrid " << grid_.geometry().width << "x" << grid_.geometry().height << " cells at "
-                                     << grid_.geometry().resolution << " m, frames " << map_frame_ << " <- "
-                                     << base_frame_);
+                                     << grid_.geometry().resolution << " m ("
+                                     << grid_.params().bytesNeeded() / (1024.0 * 1024.0) << " MiB), frames "
+                                     << node_params_.map_frame << " <- " << node_params_.base_frame);
 }
 
-FusionWorker::~FusionWorker() = default;
+FusionWorker::~FusionWorker()
+{
+  clock_timer_.stop();
+  diagnostics_timer_.stop();
+  scan_sub_.shutdown();
+}
+
+double FusionWorker::wallNow() const
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+namespace {
+
+/// The reconfigurable fields of @p p, written into @p c (what the server then shows and replies).
+void toConfig(const core::MapGridParams& p, FusionConfig& c)
+{
+  c.alpha_static = p.fusion.discount.alpha_static;
+  c.alpha_dynamic = p.fusion.discount.alpha_dynamic;
+  c.alpha_free = p.fusion.discount.alpha_free;
+  c.alpha_per_second = p.rates_per_second;
+  c.delta_inc = p.fusion.counter.delta_inc;
+  c.delta_dec = p.fusion.counter.delta_dec;
+  c.gamma_occupied = p.fusion.counter.gamma_occupied;
+  c.gamma_conflict = p.fusion.counter.gamma_conflict;
+  c.specialise_literal = p.fusion.counter.mode == core::SpecialisationMode::kLiteral;
+  c.decision_threshold = p.decision_threshold;
+  c.min_object_cells = p.min_object_cells;
+}
+
+}  // namespace
 
 void FusionWorker::onReconfigure(FusionConfig& c, uint32_t)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  core::MapGridParams p = pending_params_ ? *pending_params_ : grid_.params();
+  const core::MapGridParams in_force = pending_params_ ? *pending_params_ : grid_.params();
+  core::MapGridParams p = in_force;
   p.fusion.discount = core::ContextualRates{ c.alpha_static, c.alpha_dynamic, c.alpha_free };
   p.rates_per_second = c.alpha_per_second;
   p.fusion.counter.delta_inc = c.delta_inc;
@@ -97,10 +160,15 @@ void FusionWorker::onReconfigure(FusionConfig& c, uint32_t)
   {
     p.validate();
     pending_params_ = p;  // applied before the next scan, never mid-scan
+    last_reconfigure_ = "accepted";
+    toConfig(p, c);
   }
   catch (const core::ParameterError& e)
   {
-    ROS_ERROR_STREAM("fusion: reconfigure rejected: " << e.what());
+    ++counters_.reconfigure_refused;
+    last_reconfigure_ = std::string("refused: ") + e.what();
+    ROS_ERROR_STREAM("fusion: reconfigure refused, the previous values stay in force: " << e.what());
+    toConfig(in_force, c);
   }
 }
 
@@ -116,10 +184,10 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
     ROS_ERROR_STREAM("fusion: prior_grid rejected: " << e.what());
     return;
   }
-  if (!msg->header.frame_id.empty() && msg->header.frame_id != map_frame_)
+  if (!msg->header.frame_id.empty() && msg->header.frame_id != node_params_.map_frame)
   {
-    ROS_ERROR_STREAM("fusion: prior_grid is in frame '" << msg->header.frame_id << "', expected '" << map_frame_
-                                                        << "'; ignored");
+    ROS_ERROR_STREAM("fusion: prior_grid is in frame '" << msg->header.frame_id << "', expected '"
+                                                        << node_params_.map_frame << "'; ignored");
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -128,13 +196,111 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
                                         << prior->geometry.resolution << " m");
 }
 
+void FusionWorker::countLost(std::size_t& counter)
+{
+  ++counter;
+  lost_window_.add(wallNow());
+}
+
 void FusionWorker::onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  ++counters_.dropped_no_transform;
-  ROS_WARN_STREAM_THROTTLE(1.0, "fusion: scan at " << msg->header.stamp << " dropped: " << reasonName(reason) << " ("
-                                                   << map_frame_ << " <- " << msg->header.frame_id << "); "
-                                                   << counters_.dropped_no_transform << " dropped so far");
+  countLost(counters_.dropped_no_transform);
+  ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan at " << msg->header.stamp << " dropped: " << reasonName(reason)
+                                                             << " (" << node_params_.map_frame << " <- "
+                                                             << msg->header.frame_id << "); "
+                                                             << counters_.dropped_no_transform << " dropped so far");
+}
+
+void FusionWorker::onScanIn(const EvidentialGrid::ConstPtr& msg)
+{
+  checkClock();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double stamp = msg->header.stamp.toSec();
+    if (stamp <= 0.0)
+    {
+      countLost(counters_.zero_stamp);
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped 0 dropped (no pose can be looked up for it); "
+                                                  << counters_.zero_stamp << " so far");
+      return;
+    }
+    const ros::Time now = ros::Time::now();
+    if (!now.isZero() && stamp > now.toSec() + node_params_.future_tolerance)
+    {
+      countLost(counters_.future_stamp);
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << ", "
+                                                                     << stamp - now.toSec()
+                                                                     << " s ahead of the clock (future_tolerance "
+                                                                     << node_params_.future_tolerance
+                                                                     << " s), dropped; " << counters_.future_stamp
+                                                                     << " so far");
+      return;
+    }
+    if (!msg->header.frame_id.empty() && !tf_buffer_._frameExists(msg->header.frame_id))
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: frame '" << msg->header.frame_id
+                                                                << "' of scan_grid is unknown to tf so far; the scan "
+                                                                   "waits for a transform to "
+                                                                << node_params_.map_frame);
+  }
+  scan_filter_->add(msg);
+}
+
+void FusionWorker::resetForTimeJump(const std::string& why)
+{
+  ROS_WARN_STREAM("fusion: " << why << "; resetting the MapGrid and clearing the tf buffer");
+  grid_.reset();
+  stamp_guard_.reset();
+  last_pose_.reset();
+  tf_buffer_.clear();
+  ++counters_.resets;
+  ++counters_.tf_clears;
+}
+
+void FusionWorker::checkClock()
+{
+  const ros::Time now = ros::Time::now();
+  if (now.isZero()) return;
+  std::string frame;
+  bool jumped = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    jumped = clock_jump_.observe(now.toSec());
+    if (jumped)
+    {
+      std::ostringstream why;
+      why << "ROS time went back by more than time_jump_threshold (" << node_params_.time.time_jump_threshold
+          << " s) to " << now;
+      resetForTimeJump(why.str());
+    }
+    frame = last_scan_frame_;
+  }
+  if (jumped)
+  {
+    scan_filter_->clear();  // scans of before the jump still waiting for their transform
+    return;
+  }
+  if (frame.empty()) return;
+  // After a jump, transforms of the previous loop may still arrive; tf2 would then ignore the new loop's
+  // transforms as too old. Transforms ahead of the clock by more than the threshold are from the past loop.
+  ros::Time latest;
+  try
+  {
+    latest = tf_buffer_.lookupTransform(node_params_.map_frame, frame, ros::Time(0)).header.stamp;
+  }
+  catch (const tf2::TransformException&)
+  {
+    return;
+  }
+  if ((latest - now).toSec() > node_params_.time.time_jump_threshold)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ROS_WARN_STREAM("fusion: the tf buffer holds " << node_params_.map_frame << " <- " << frame << " at " << latest
+                                                  << ", ahead of the clock (" << now
+                                                  << "): transforms of before a time jump; cleared");
+    tf_buffer_.clear();
+    ++counters_.tf_clears;
+  }
 }
 
 void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
@@ -147,46 +313,95 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     for (std::size_t i = 0; i < scan.numCells(); ++i)
     {
       const float s = scan.plane(0)[i] + scan.plane(1)[i] + scan.plane(2)[i] + scan.plane(3)[i];
-      if (!(std::abs(s - 1.0f) < 1e-3f) || scan.plane(1)[i] < 0.0f || scan.plane(2)[i] < 0.0f || scan.plane(3)[i] < 0.0f)
+      if (!(std::abs(s - 1.0f) < 1e-3f) || !(scan.plane(0)[i] >= 0.0f) || !(scan.plane(1)[i] >= 0.0f) ||
+          !(scan.plane(2)[i] >= 0.0f) || !(scan.plane(3)[i] >= 0.0f))
         throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " + std::to_string(s) + ")");
     }
   }
   catch (const ConversionError& e)
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++counters_.rejected;
-    ROS_ERROR_STREAM_THROTTLE(1.0, "fusion: scan_grid rejected (" << counters_.rejected << " so far): " << e.what());
+    countLost(counters_.rejected);
+    ROS_ERROR_STREAM_THROTTLE(kWarnThrottle, "fusion: scan_grid rejected (" << counters_.rejected
+                                                                            << " so far): " << e.what());
     return;
   }
   geometry_msgs::TransformStamped tf;
   try
   {
-    tf = tf_buffer_.lookupTransform(map_frame_, msg->header.frame_id, msg->header.stamp);
+    tf = tf_buffer_.lookupTransform(node_params_.map_frame, msg->header.frame_id, msg->header.stamp);
   }
   catch (const tf2::TransformException& e)
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++counters_.dropped_no_transform;
-    ROS_WARN_STREAM_THROTTLE(1.0, "fusion: scan dropped: " << e.what());
+    countLost(counters_.dropped_no_transform);
+    ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan dropped: " << e.what());
     return;
   }
   core::Pose2 pose;
   pose.x = tf.transform.translation.x;
   pose.y = tf.transform.translation.y;
   pose.yaw = tf2::getYaw(tf.transform.rotation);
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw))
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    countLost(counters_.rejected);
+    ROS_ERROR_STREAM_THROTTLE(kWarnThrottle, "fusion: scan dropped: the transform " << node_params_.map_frame << " <- "
+                                                                                    << msg->header.frame_id
+                                                                                    << " is not finite");
+    return;
+  }
 
   std::lock_guard<std::mutex> lock(mutex_);
+  last_scan_frame_ = msg->header.frame_id;
   if (pending_params_)
   {
     grid_.setParams(*pending_params_);
     pending_params_.reset();
   }
-  if (last_stamp_ && msg->header.stamp + kBackwardTolerance < *last_stamp_)
+  const double stamp = msg->header.stamp.toSec();
+  switch (stamp_guard_.check(stamp))
   {
-    ROS_WARN_STREAM("fusion: time went backwards (" << *last_stamp_ << " -> " << msg->header.stamp
-                                                     << "); resetting the MapGrid");
-    grid_.reset();
-    ++counters_.resets;
+    case core::StampVerdict::kFuse:
+      break;
+    case core::StampVerdict::kZeroStamp:
+      countLost(counters_.zero_stamp);
+      return;
+    case core::StampVerdict::kDuplicate:
+      countLost(counters_.duplicate);
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp
+                                                                     << " again (already fused), dropped; "
+                                                                     << counters_.duplicate << " so far");
+      return;
+    case core::StampVerdict::kOutOfOrder:
+      countLost(counters_.out_of_order);
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << " is "
+                                                                     << *stamp_guard_.last() - stamp
+                                                                     << " s older than the last fused scan, dropped "
+                                                                        "(out of order); "
+                                                                     << counters_.out_of_order << " so far");
+      return;
+    case core::StampVerdict::kTimeJump: {
+      std::ostringstream why;
+      why << "scan time went back from " << std::fixed << *stamp_guard_.last() << " to " << stamp
+          << " s, more than time_jump_threshold (" << node_params_.time.time_jump_threshold << " s)";
+      resetForTimeJump(why.str());
+      break;
+    }
+  }
+  if (last_pose_)
+  {
+    const core::PoseJump j = core::checkPoseJump(last_pose_->x, last_pose_->y, last_pose_stamp_, pose.x, pose.y,
+                                                 stamp, node_params_.time.max_plausible_speed);
+    if (j.jumped)
+    {
+      ++counters_.pose_jumps;
+      ROS_WARN_STREAM("fusion: the vehicle moved " << j.distance << " m in " << stamp - last_pose_stamp_ << " s ("
+                                                   << j.speed << " m/s, max_plausible_speed "
+                                                   << node_params_.time.max_plausible_speed
+                                                   << "): a localisation jump? Evidence is kept where the window "
+                                                      "still covers it");
+    }
   }
   if (!prior_ && !warned_no_prior_)
   {
@@ -194,22 +409,19 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     warned_no_prior_ = true;
   }
   core::StageTimes times;
-  const auto stats = grid_.update(scan, pose, msg->header.stamp.toSec(), prior_.get(), &times);
-  last_stamp_ = msg->header.stamp;
+  const auto stats = grid_.update(scan, pose, stamp, prior_.get(), &times);
+  stamp_guard_.accept(stamp);
+  last_pose_ = pose;
+  last_pose_stamp_ = stamp;
   ++counters_.fused;
+  last_fused_wall_ = wallNow();
+  fused_window_.add(last_fused_wall_);
   last_times_ = times;
   last_mean_conflict_ = stats.meanConflict();
-  const auto now = ros::WallTime::now();
-  if (!last_scan_wall_.isZero())
-  {
-    const double dt = (now - last_scan_wall_).toSec();
-    if (dt > 0.0) scan_rate_ = 1.0 / dt;
-  }
-  last_scan_wall_ = now;
 
   std_msgs::Header header;
   header.stamp = msg->header.stamp;
-  header.frame_id = map_frame_;
+  header.frame_id = node_params_.map_frame;
   publish(header);
   last_total_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
@@ -248,14 +460,14 @@ void FusionWorker::publish(const std_msgs::Header& header)
   if (cells_pub_.getNumSubscribers() > 0)
   {
     auto cells = boost::make_shared<visualization_msgs::MarkerArray>();
-    Visualization::decisionToCells(grid.geometry(), decision, header, publish_free_cells_, *cells);
+    Visualization::decisionToCells(grid.geometry(), decision, header, node_params_.publish_free_cells, *cells);
     cells_pub_.publish(cells);
   }
   if (objects_pub_.getNumSubscribers() > 0)
   {
     auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
     const auto objects = core::extractObjects(grid.geometry(), decision, betp, grid_.params().min_object_cells);
-    Visualization::objectsToMarkers(objects, header, object_box_height_, *markers);
+    Visualization::objectsToMarkers(objects, header, node_params_.object_box_height, *markers);
     objects_pub_.publish(markers);
   }
 }
@@ -263,23 +475,37 @@ void FusionWorker::publish(const std_msgs::Header& header)
 void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (counters_.fused == 0)
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no scan fused yet");
-  else if (counters_.dropped_no_transform + counters_.rejected > 0)
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "scans dropped or rejected");
-  else
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "fusing");
+  const double now = wallNow();
+  const core::StreamHealthParams& h = node_params_.health;
+  const std::size_t fused = fused_window_.count(now);
+  const std::size_t lost = lost_window_.count(now);
+  const double last = counters_.fused > 0 ? last_fused_wall_ : now;
+  const core::HealthSummary summary = core::streamHealth(h, counters_.fused > 0, now - last, fused, lost, "scans fused");
+  status.summary(static_cast<unsigned char>(summary.level), summary.message);
+  status.add("scan rate [Hz]", fused_window_.rate(now, start_wall_));
+  status.add("scans fused in window", fused);
+  status.add("scans dropped or rejected in window", lost);
+  status.add("window [s]", h.diagnostic_window);
+  status.add("seconds since last fused scan", counters_.fused > 0 ? now - last : -1.0);
   status.add("scans fused", counters_.fused);
   status.add("scans dropped (no transform)", counters_.dropped_no_transform);
   status.add("scans rejected (malformed)", counters_.rejected);
-  status.add("grid resets (time backwards)", counters_.resets);
-  status.add("scan rate [Hz]", scan_rate_);
+  status.add("scans dropped (zero stamp)", counters_.zero_stamp);
+  status.add("scans dropped (future stamp)", counters_.future_stamp);
+  status.add("scans dropped (out of order)", counters_.out_of_order);
+  status.add("scans dropped (duplicate stamp)", counters_.duplicate);
+  status.add("grid resets (time jump)", counters_.resets);
+  status.add("tf buffer clears", counters_.tf_clears);
+  status.add("pose jumps", counters_.pose_jumps);
+  status.add("reconfigure refused", counters_.reconfigure_refused);
+  status.add("last reconfigure", last_reconfigure_);
   status.add("time shift [ms]", 1e3 * last_times_.shift);
   status.add("time project scan [ms]", 1e3 * last_times_.project_scan);
   status.add("time prior window [ms]", 1e3 * last_times_.prior_window);
   status.add("time fusion [ms]", 1e3 * last_times_.fusion);
   status.add("time total with outputs [ms]", 1e3 * last_total_seconds_);
   status.add("mean conflict", last_mean_conflict_);
+  status.add("memory [MiB]", grid_.params().bytesNeeded() / (1024.0 * 1024.0));
   status.add("prior", prior_ ? "received" : "none (vacuous)");
 }
 

@@ -19,6 +19,7 @@ namespace {
 constexpr std::size_t kMaxLoggedSkips = 10;
 constexpr double kOutlineWidth = 0.2;  // metres
 constexpr int kQueueSize = 1;
+constexpr double kDiagnosticPeriod = 1.0;  // s, wall time
 
 struct Rgba
 {
@@ -92,7 +93,49 @@ PriorGridNode::PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
   occupancy_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("prior_grid/occupancy", kQueueSize, latched);
   outlines_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("prior_grid/outlines", kQueueSize, latched);
   reload_srv_ = pnh_.advertiseService("reload", &PriorGridNode::reload, this);
+  diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
+  diagnostics_->setHardwareID("map_loader");
+  diagnostics_->add("PriorGrid", this, &PriorGridNode::diagnose);
   load();
+  diagnostics_->force_update();
+  diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticPeriod),
+                                           [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
+}
+
+void PriorGridNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (loaded_)
+    status.summary(report_.skipped_geometries > 0 ? diagnostic_msgs::DiagnosticStatus::WARN :
+                                                    diagnostic_msgs::DiagnosticStatus::OK,
+                   report_.skipped_geometries > 0 ? "published; some geometries skipped (see the counts)" :
+                                                    "published");
+  else
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "nothing published: " + status_);
+  status.add("file", report_.file);
+  status.add("driver", report_.driver);
+  status.add("loads", loads_);
+  status.add("last load", status_);
+  status.add("origin latitude [deg]", report_.origin_latitude);
+  status.add("origin longitude [deg]", report_.origin_longitude);
+  status.add("origin altitude [m]", report_.origin_altitude);
+  status.add("features read", report_.features_read);
+  status.add("buildings kept", report_.buildings);
+  status.add("road areas kept", report_.road_areas);
+  status.add("road lines kept", report_.road_lines);
+  status.add("geometries repaired", report_.repaired_geometries);
+  status.add("holes dropped (outside or around their shell)", report_.dropped_holes);
+  status.add("geometries skipped", report_.skipped_geometries);
+  status.add("skipped: unclosed", report_.skipped_unclosed);
+  status.add("skipped: missing nodes", report_.skipped_missing_nodes);
+  status.add("skipped: incomplete relations", report_.skipped_incomplete_relations);
+  status.add("skipped: degenerate or out of range coordinates", report_.skipped_degenerate);
+  status.add("skipped: invalid", report_.skipped_invalid);
+  status.add("skipped: too many vertices", report_.skipped_too_many_vertices);
+  status.add("skipped: farther than max_origin_distance", report_.skipped_out_of_range);
+  status.add("grid [cells]", std::to_string(published_.width) + " x " + std::to_string(published_.height));
+  status.add("grid resolution [m]", published_.resolution);
+  status.add("grid origin [m]", std::to_string(published_.origin_x) + ", " + std::to_string(published_.origin_y));
 }
 
 bool PriorGridNode::reload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res)
@@ -109,8 +152,12 @@ bool PriorGridNode::load()
   {
     map_io::PriorGridParams params = readPriorGridParams(pnh_);
     params.validate();
+    ++loads_;
+    report_ = map_io::MapLoadReport{};
+    report_.file = params.map.file;
     map_io::MapLoadReport report;
     const core::VectorMap map = map_io::loadVectorMap(params.map, &report);
+    report_ = report;
     ROS_INFO_STREAM("prior_grid: " << map_io::summary(report));
     for (std::size_t i = 0; i < std::min(kMaxLoggedSkips, report.messages.size()); ++i)
       ROS_WARN_STREAM("prior_grid: skipped " << report.messages[i]);
@@ -143,6 +190,7 @@ void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::V
                     << params.publish_centre_y << ")");
   core::PriorBuildStats stats;
   grid_.build(map, window, &stats);
+  published_ = window;
   const core::PriorClassCounts n = grid_.classCounts();
   status_ = "published " + std::to_string(window.width) + " x " + std::to_string(window.height) + " cells: " +
             std::to_string(n[static_cast<int>(core::PriorClass::kBuilding)]) + " building, " +

@@ -1,6 +1,7 @@
 #include "map_aided_fusion/ros/scan_grid_worker.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 
 #include <boost/make_shared.hpp>
@@ -18,6 +19,27 @@ namespace {
 
 constexpr int kMaxQueueSize = 1000;
 constexpr double kMillisecondsPerSecond = 1000.0;
+constexpr double kMaxFutureTolerance = 3600.0;
+constexpr double kMinJumpThreshold = 0.001;
+constexpr double kMaxJumpThreshold = 3600.0;
+/// Wall period of the clock watch (backward /clock jumps), s.
+constexpr double kClockCheckPeriod = 0.1;
+
+/// The reconfigurable fields of @p m, written into @p c (what the server then shows and replies).
+void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
+{
+  c.azimuth_resolution_deg = m.azimuth_resolution_deg;
+  c.min_range = m.min_range;
+  c.max_range = m.max_range;
+  c.ground_height = m.ground_height;
+  c.ground_tolerance = m.ground_tolerance;
+  c.obstacle_min_height = m.obstacle_min_height;
+  c.obstacle_max_height = m.obstacle_max_height;
+  c.mu_free = m.mu_free;
+  c.mu_occupied = m.mu_occupied;
+  c.free_decay_length = m.free_decay_length;
+  c.free_margin = m.free_margin;
+}
 
 Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
 {
@@ -34,7 +56,9 @@ void ScanGridNodeParams::validate() const
   if (base_frame.empty()) throw core::ParameterError("base_frame", "must not be empty");
   core::requireInRange("input_queue_size", input_queue_size, 1, kMaxQueueSize);
   core::requireInRange("tf_queue_size", tf_queue_size, 1, kMaxQueueSize);
-  core::requirePositive("diagnostic_period", diagnostic_period);
+  core::requireInRange("future_tolerance", future_tolerance, 0.0, kMaxFutureTolerance);
+  core::requireInRange("time_jump_threshold", time_jump_threshold, kMinJumpThreshold, kMaxJumpThreshold);
+  health.validate();
   model.validate();
 }
 
@@ -44,7 +68,9 @@ ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "base_frame", p.base_frame);
   readParam(pnh, "input_queue_size", p.input_queue_size);
   readParam(pnh, "tf_queue_size", p.tf_queue_size);
-  readParam(pnh, "diagnostic_period", p.diagnostic_period);
+  readParam(pnh, "future_tolerance", p.future_tolerance);
+  readParam(pnh, "time_jump_threshold", p.time_jump_threshold);
+  core::forEachParam(p.health, parameterServerReader(pnh));
   core::forEachParam(p.model, parameterServerReader(pnh));
   p.validate();
   return p;
@@ -77,9 +103,13 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   updater_->setHardwareID("scan_grid");
   updater_->add("ScanGrid", this, &ScanGridWorker::diagnose);
-  window_start_ = ros::WallTime::now();
-  diagnostic_timer_ = nh_.createWallTimer(ros::WallDuration(params_.diagnostic_period),
+  for (auto* w : { &received_window_, &published_window_, &rejected_window_ }) w->setSpan(params_.health.diagnostic_window);
+  start_wall_ = wallNow();
+  clock_jump_.setThreshold(params_.time_jump_threshold);
+  diagnostic_timer_ = nh_.createWallTimer(ros::WallDuration(params_.health.diagnostic_period),
                                           [this](const ros::WallTimerEvent&) { updater_->force_update(); });
+  clock_timer_ =
+      nh_.createWallTimer(ros::WallDuration(kClockCheckPeriod), [this](const ros::WallTimerEvent&) { checkClock(); });
 
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ScanGridConfig>>(pnh_);
   reconfigure_->setCallback(
@@ -100,6 +130,7 @@ ScanGridWorker::~ScanGridWorker()
 {
   cloud_sub_.shutdown();
   diagnostic_timer_.stop();
+  clock_timer_.stop();
   tf_filter_.reset();
 }
 
@@ -107,7 +138,7 @@ void ScanGridWorker::reject(const std::string& reason, const std::string& detail
 {
   ++counters_.clouds_rejected;
   ++counters_.rejections[reason];
-  ++window_rejected_;
+  rejected_window_.add(wallNow());
   if (reported_.insert(reason).second)
     ROS_ERROR("scan_grid: rejected a cloud on %s (%s): %s. Further clouds rejected for this reason are only "
               "counted (see diagnostics).",
@@ -125,12 +156,34 @@ bool ScanGridWorker::viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCl
   return false;
 }
 
+double ScanGridWorker::wallNow() const
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void ScanGridWorker::checkClock()
+{
+  const ros::Time now = ros::Time::now();
+  if (now.isZero()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!clock_jump_.observe(now.toSec())) return;
+    ++tf_clears_;
+    ROS_WARN("scan_grid: ROS time went back by more than time_jump_threshold (%.3f s) to %.3f; clearing the tf "
+             "buffer and the clouds waiting for a transform",
+             params_.time_jump_threshold, now.toSec());
+    tf_buffer_->clear();
+  }
+  tf_filter_->clear();
+}
+
 void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
+  checkClock();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.clouds_received;
-    ++window_clouds_;
+    received_window_.add(wallNow());
     core::PointCloudView view;
     if (!viewOf(*cloud, view)) return;
     if (cloud->header.frame_id.empty())
@@ -138,6 +191,25 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
       reject("no_frame_id", "header.frame_id is empty");
       return;
     }
+    if (cloud->header.stamp.isZero())
+    {
+      reject("zero_stamp", "header.stamp is 0: no transform can be looked up for it");
+      return;
+    }
+    const ros::Time now = ros::Time::now();
+    if (!now.isZero() && (cloud->header.stamp - now).toSec() > params_.future_tolerance)
+    {
+      reject("future_stamp", "stamped " + std::to_string((cloud->header.stamp - now).toSec()) +
+                                 " s ahead of the clock (future_tolerance " + std::to_string(params_.future_tolerance) +
+                                 " s)");
+      return;
+    }
+    const std::string& frame = cloud->header.frame_id;
+    const std::string source = frame[0] != '/' ? frame : frame.substr(1);
+    if (!tf_buffer_->_frameExists(source))
+      ROS_WARN_THROTTLE(1.0, "scan_grid: frame '%s' of %s is unknown to tf so far; the cloud waits for a transform "
+                             "to %s",
+                        frame.c_str(), cloud_sub_.getTopic().c_str(), params_.base_frame.c_str());
     if (grid_pub_.getNumSubscribers() == 0 && occupancy_pub_.getNumSubscribers() == 0)
     {
       ++counters_.clouds_skipped;
@@ -205,6 +277,8 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
     occupancy_pub_.publish(occupancy);
   }
   ++counters_.clouds_published;
+  last_published_wall_ = wallNow();
+  published_window_.add(last_published_wall_);
   const double elapsed = (ros::WallTime::now() - start).toSec();
   window_processing_sum_ += elapsed;
   window_processing_max_ = std::max(window_processing_max_, elapsed);
@@ -230,30 +304,34 @@ void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level
   {
     builder_.configure(m, builder_.sensorPose());
     params_.model = m;
+    last_reconfigure_ = "accepted";
   }
   catch (const core::ParameterError& e)
   {
-    ROS_ERROR("scan_grid: reconfiguration rejected, keeping the previous parameters: %s", e.what());
+    ++reconfigure_refused_;
+    last_reconfigure_ = std::string("refused: ") + e.what();
+    ROS_ERROR("scan_grid: reconfigure refused, the previous values stay in force: %s", e.what());
   }
+  toConfig(params_.model, config);
 }
 
 void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  const ros::WallTime now = ros::WallTime::now();
-  const double window = std::max((now - window_start_).toSec(), std::numeric_limits<double>::min());
-  const double rate = static_cast<double>(window_clouds_) / window;
+  const double now = wallNow();
+  const std::size_t published = published_window_.count(now);
+  const std::size_t rejected = rejected_window_.count(now);
   const double mean_ms = window_processed_ > 0 ? kMillisecondsPerSecond * window_processing_sum_ /
                                                      static_cast<double>(window_processed_) :
                                                  0.0;
-  if (window_rejected_ > 0)
-    status.summaryf(diagnostic_updater::DiagnosticStatusWrapper::WARN, "%zu of %zu clouds rejected", window_rejected_,
-                    window_clouds_);
-  else if (window_clouds_ == 0)
-    status.summary(diagnostic_updater::DiagnosticStatusWrapper::WARN, "no input cloud");
-  else
-    status.summaryf(diagnostic_updater::DiagnosticStatusWrapper::OK, "%.1f Hz, %.2f ms per cloud", rate, mean_ms);
-  status.add("input rate (Hz)", rate);
+  const bool ever = counters_.clouds_published > 0;
+  const core::HealthSummary h = core::streamHealth(params_.health, ever, ever ? now - last_published_wall_ : 0.0,
+                                                   published, rejected, "clouds published");
+  status.summary(static_cast<unsigned char>(h.level), h.message);
+  status.add("input rate (Hz)", received_window_.rate(now, start_wall_));
+  status.add("output rate (Hz)", published_window_.rate(now, start_wall_));
+  status.add("clouds rejected in window", rejected);
+  status.add("window (s)", params_.health.diagnostic_window);
   status.add("processing time mean (ms)", mean_ms);
   status.add("processing time max (ms)", kMillisecondsPerSecond * window_processing_max_);
   status.add("clouds received", counters_.clouds_received);
@@ -262,6 +340,9 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("clouds skipped (no subscriber)", counters_.clouds_skipped);
   for (const auto& r : counters_.rejections) status.add("clouds rejected: " + r.first, r.second);
   status.add("points rejected", counters_.points_rejected);
+  status.add("tf buffer clears (time jump)", tf_clears_);
+  status.add("reconfigure refused", reconfigure_refused_);
+  status.add("last reconfigure", last_reconfigure_);
   status.add("last cloud: points", last_stats_.points);
   status.add("last cloud: non-finite", last_stats_.non_finite);
   status.add("last cloud: no return (0,0,0)", last_stats_.no_return);
@@ -271,9 +352,8 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
                                                   std::to_string(last_stats_.obstacle));
   status.add("last cloud: occupied / free cells", std::to_string(last_stats_.occupied_cells) + " / " +
                                                       std::to_string(last_stats_.free_cells));
-  window_clouds_ = window_rejected_ = window_processed_ = 0;
+  window_processed_ = 0;
   window_processing_sum_ = window_processing_max_ = 0.0;
-  window_start_ = now;
 }
 
 }  // namespace map_aided_fusion

@@ -131,13 +131,13 @@ int main(int argc, char** argv)
     else if (a == "--origin")
       ok = parseOrigin(value(), params);
     else if (a == "--resolution")
-      ok = number(resolution);
+      ok = number(resolution) && std::isfinite(resolution) && resolution > 0.0;
     else if (a == "--margin")
-      ok = number(margin);
+      ok = number(margin) && std::isfinite(margin) && margin >= 0.0;
     else if (a == "--max-cells")
-      ok = number(max_cells);
+      ok = number(max_cells) && std::isfinite(max_cells) && max_cells >= 1.0;
     else if (a == "--size")
-      ok = number(size) && size > 0.0;
+      ok = number(size) && std::isfinite(size) && size > 0.0;
     else if (a == "--centre")
     {
       centre = parseList(value());

@@ -44,7 +44,17 @@ struct MapGridParams
   double recentre_distance = 5.0;
   double decision_threshold = 0.4;  ///< BetP a class needs to be a cell's decision, in [0, 1]
   int min_object_cells = 3;         ///< smaller connected S or V regions are noise (cells, ≥ 1)
-  /// @throws ParameterError naming the first parameter out of range.
+  /**
+   * Memory the MapGrid's window may take, MiB (in [1, 1048576]). A window whose cells would need more
+   * (bytesPerCell() each: every focal-set plane, ζ, BetP, the projected scan, the prior window and the
+   * decision) is refused by validate(), before anything is allocated.
+   */
+  double memory_budget_mb = 2048.0;
+  /// Bytes one window cell needs in the MapGrid and its per-scan buffers.
+  static std::size_t bytesPerCell();
+  /// Bytes the window of these parameters needs (cells × bytesPerCell()).
+  double bytesNeeded() const;
+  /// @throws ParameterError naming the first parameter out of range, or the window size over the budget.
   void validate() const;
 };
 
@@ -72,6 +82,7 @@ void forEachParam(MapGridParams& p, Get&& get)
   p.fusion.counter.mode = literal ? SpecialisationMode::kLiteral : SpecialisationMode::kMovingToStopped;
   get("decision_threshold", p.decision_threshold);
   get("min_object_cells", p.min_object_cells);
+  get("memory_budget_mb", p.memory_budget_mb);
 }
 
 /// Wall time of each stage of MapGrid::update(), seconds.

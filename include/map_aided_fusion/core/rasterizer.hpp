@@ -27,7 +27,11 @@ struct CellSpan
   int col_end = 0;
 };
 
-/// Scanline filler over a grid; reuse one instance to avoid reallocations.
+/**
+ * Scanline filler over a grid; reuse one instance to avoid reallocations. Rows are swept with an active
+ * edge list: memory is O(edges), whatever the number of rows an edge spans (a zig-zag ring of 10^6
+ * vertices needs tens of MB, not one entry per edge per row).
+ */
 class ScanlineRasterizer
 {
 public:
@@ -50,10 +54,19 @@ public:
   void fill(const Ring& ring, std::vector<CellSpan>& spans);
 
 private:
+  /// An edge crossing the centre lines of rows [row_begin, row_end).
+  struct Edge
+  {
+    long row_begin;
+    long row_end;
+    double ax, ay, slope;  ///< x at a row centre yc is ax + (yc − ay)·slope
+  };
   void addRing(const Ring& ring);
 
   GridGeometry geometry_;
-  std::vector<std::pair<int, double>> crossings_;  ///< (row, x of the edge at the row's centre line)
+  std::vector<Edge> edges_;
+  std::vector<std::size_t> active_;
+  std::vector<double> row_x_;
 };
 
 /// Polygons covering a road centre line buffered by half its width: one rectangle per segment and a regular

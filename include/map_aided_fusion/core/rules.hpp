@@ -15,9 +15,10 @@ namespace core {
 
 /**
  * @brief Below this normalisation factor 1 − K, Dempster's rule treats the sources as in total
- *        conflict (see dempster()).
+ *        conflict (see dempster()). Below ~1e-10 the normalised result is rounding noise of the
+ *        products (float kernels) that no longer sums to 1.
  */
-constexpr double kTotalConflictThreshold = 1e-12;
+constexpr double kTotalConflictThreshold = 1e-10;
 
 /// Unnormalised conjunctive rule (m1 ∩ m2)(A) = Σ_{B∩C=A} m1(B) m2(C); m(∅) is the conflict and is kept.
 template <class Frame>
@@ -55,6 +56,7 @@ struct DempsterReport
 /**
  * @brief Dempster's rule: (m1 ⊕ m2)(A) = (m1 ∩ m2)(A) / (1 − K) for A ≠ ∅, and 0 on ∅.
  *
+ * The normalisation divides by the sum of the non-empty conjunctive masses (1 − K without its rounding).
  * Total conflict (1 − K < kTotalConflictThreshold) has no Dempster combination; the defined outcome
  * is the vacuous mass function (m(Ω) = 1: the two sources cancel out), with report->total_conflict set.
  * Inputs with m(∅) > 0 are accepted; their ∅ mass counts as conflict.
@@ -65,10 +67,11 @@ MassFunction<Frame> dempster(const MassFunction<Frame>& m1, const MassFunction<F
 {
   auto r = conjunctive(m1, m2);
   const double k = r[0];
-  const double norm = 1.0 - k;
+  r[0] = 0.0;
+  double norm = 0.0;  // the non-empty masses: 1 − K up to rounding, never negative
+  for (const auto v : r.values()) norm += v;
   if (report) *report = DempsterReport{ k, norm < kTotalConflictThreshold };
   if (norm < kTotalConflictThreshold) return MassFunction<Frame>::vacuous();
-  r[0] = 0.0;
   for (auto& v : r.values()) v /= norm;
   return r;
 }

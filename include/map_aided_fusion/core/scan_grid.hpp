@@ -43,11 +43,13 @@ namespace core {
 struct ScanGridParams
 {
   // Grid (vehicle frame, base_link), centred on (grid_offset_x, grid_offset_y).
-  double grid_resolution = 0.5;  ///< cell side, m (> 0); the paper's 0.5 m
-  double grid_size_x = 100.0;    ///< extent along x, m (≥ one cell)
-  double grid_size_y = 100.0;    ///< extent along y, m (≥ one cell)
-  double grid_offset_x = 0.0;    ///< x of the grid centre in base_link, m
-  double grid_offset_y = 0.0;    ///< y of the grid centre in base_link, m
+  // Every length below is bounded by 10 km (and the sensor pose by 1 km), so that no cell index, range or
+  // angle leaves the range of float and int.
+  double grid_resolution = 0.5;  ///< cell side, m, in [0.01, 10000]; the paper's 0.5 m
+  double grid_size_x = 100.0;    ///< extent along x, m (≥ one cell, ≤ 10000)
+  double grid_size_y = 100.0;    ///< extent along y, m (≥ one cell, ≤ 10000)
+  double grid_offset_x = 0.0;    ///< x of the grid centre in base_link, m, in [−10000, 10000]
+  double grid_offset_y = 0.0;    ///< y of the grid centre in base_link, m, in [−10000, 10000]
 
   // Polar model.
   double azimuth_resolution_deg = 0.25;  ///< width of an azimuth sector, degrees, in [0.01, 45]

@@ -78,7 +78,7 @@ struct MapLoadParams
   /// Origin of the `map` frame (WGS84). NaN latitude/longitude: the centre of the data's bounding box.
   double origin_latitude = std::numeric_limits<double>::quiet_NaN();   ///< degrees, [-90, 90]
   double origin_longitude = std::numeric_limits<double>::quiet_NaN();  ///< degrees, [-180, 180]
-  double origin_altitude = 0.0;                                        ///< metres above the ellipsoid
+  double origin_altitude = 0.0;  ///< metres above the ellipsoid, [-1000, 10000]
   /// True: coordinates are already metric in the `map` frame (HD maps in local coordinates); no projection.
   bool metric = false;
   /// Data whose nearest vertex is farther than this from the origin is an error; features entirely farther
@@ -109,6 +109,8 @@ struct MapLoadParams
   std::map<std::string, double> road_class_widths = defaultRoadClassWidths();  ///< metres (> 0)
   /// Repair invalid polygons (self-intersections…) with GEOS (OGRGeometry::MakeValid); false: keep as read.
   bool repair_invalid = true;
+  /// Features with more vertices are skipped and counted (a guard against pathological geometry), [3, 1e8].
+  int max_vertices_per_feature = 100000;
 
   /// @throws core::ParameterError naming the offending parameter.
   void validate() const;
@@ -134,6 +136,7 @@ struct MapLoadReport
   std::size_t road_areas = 0;              ///< road area polygons kept
   std::size_t road_lines = 0;              ///< road centre lines kept
   std::size_t repaired_geometries = 0;     ///< invalid polygons repaired
+  std::size_t dropped_holes = 0;           ///< holes outside their shell or enclosing it, dropped
   std::size_t excluded_tunnels = 0;        ///< drivable roads left out because they are tunnels
   std::size_t skipped_geometries = 0;      ///< total skipped (the sum of the counts below)
   std::size_t skipped_unclosed = 0;        ///< building/road-area ways that are not closed rings
@@ -142,7 +145,8 @@ struct MapLoadReport
   std::size_t skipped_incomplete_relations = 0;  ///< OSM relations (any kind) ignored: member ways missing
   std::size_t skipped_degenerate = 0;      ///< fewer than 3 distinct vertices (polygons) or 2 (lines), NaN
   std::size_t skipped_invalid = 0;         ///< invalid polygons not repaired
-  std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance from the origin
+  std::size_t skipped_out_of_range = 0;    ///< farther than max_origin_distance (or on the far side of the globe)
+  std::size_t skipped_too_many_vertices = 0;  ///< more than max_vertices_per_feature vertices
   std::size_t read_errors = 0;             ///< GDAL errors while reading features (truncated file…)
   std::vector<std::string> messages;       ///< the first few skip reasons, with feature ids
 };

@@ -76,6 +76,7 @@ void forEachPriorGridParam(PriorGridParams& p, Get&& get)
   get("default_road_width", m.default_road_width);
   get("road_class_widths", m.road_class_widths);
   get("repair_invalid", m.repair_invalid);
+  get("max_vertices_per_feature", m.max_vertices_per_feature);
   get("frame_id", p.frame_id);
   get("resolution", p.resolution);
   get("beta_building", p.beta.beta_building);

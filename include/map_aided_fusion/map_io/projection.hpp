@@ -21,8 +21,9 @@ public:
   LocalProjector(LocalProjector&&) noexcept;
   LocalProjector& operator=(LocalProjector&&) noexcept;
 
-  /// (east, north) in metres of a point at the origin's altitude.
-  core::Point2 forward(double latitude, double longitude) const;
+  /// (east, north) in metres of a point at the origin's altitude; @p up, when given, receives its up
+  /// coordinate (negative away from the origin: the Earth's curvature; about −12.7e6 m at the antipode).
+  core::Point2 forward(double latitude, double longitude, double* up = nullptr) const;
   /// (latitude, longitude) in degrees of a map-frame point at the origin's altitude.
   void reverse(core::Point2 p, double& latitude, double& longitude) const;
 

@@ -13,7 +13,6 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
-#include <message_filters/subscriber.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
@@ -22,19 +21,53 @@
 #include "map_aided_fusion/EvidentialGrid.h"
 #include "map_aided_fusion/FusionConfig.h"
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/sliding_window.hpp"
+#include "map_aided_fusion/core/stamp_guard.hpp"
 
 namespace map_aided_fusion {
 
-/// Counters reported on /diagnostics.
+/// Counters since start, reported on /diagnostics.
 struct FusionCounters
 {
   std::size_t fused = 0;                ///< scans fused
   std::size_t dropped_no_transform = 0; ///< scans dropped by the tf message filter
   std::size_t rejected = 0;             ///< malformed scan grids
-  std::size_t resets = 0;               ///< grid resets (time going backwards)
+  std::size_t zero_stamp = 0;           ///< scans stamped 0
+  std::size_t future_stamp = 0;         ///< scans stamped further ahead of the clock than future_tolerance
+  std::size_t out_of_order = 0;         ///< scans older than the last fused one (within time_jump_threshold)
+  std::size_t duplicate = 0;            ///< scans with the stamp of the last fused one
+  std::size_t resets = 0;               ///< grid resets (genuine time jumps only)
+  std::size_t tf_clears = 0;            ///< tf buffer cleared (time jump, or transforms ahead of the clock)
+  std::size_t pose_jumps = 0;           ///< vehicle moved faster than max_plausible_speed between two scans
+  std::size_t reconfigure_refused = 0;  ///< dynamic_reconfigure requests refused
 };
 
-/// Topics: in `scan_grid`, `prior_grid`; out `map_grid`, `betp/*`, `decision`, `cells`, `objects`.
+/// The fusion node's own parameters besides the MapGrid's (config/fusion.yaml).
+struct FusionNodeParams
+{
+  std::string map_frame = "map";        ///< fixed frame of the MapGrid and the PriorGrid
+  std::string base_frame = "base_link"; ///< vehicle frame (informational)
+  int tf_queue_size = 5;                ///< scans waiting for their transform, [1, 1000]
+  double future_tolerance = 1.0;        ///< s a scan may be stamped ahead of the clock, [0, 3600]
+  bool publish_free_cells = false;      ///< also draw free cells in `cells`
+  double object_box_height = 1.5;       ///< m, height of the object boxes, (0, 100]
+  core::TimeGuardParams time;           ///< out-of-order, time-jump and pose-jump thresholds
+  core::StreamHealthParams health;      ///< diagnostics period, window and staleness
+  /// @throws core::ParameterError naming the first bad parameter.
+  void validate() const;
+  /// Reads every parameter from @p pnh, keeping defaults for absent ones, and validates.
+  static FusionNodeParams load(const ros::NodeHandle& pnh);
+};
+
+/**
+ * Topics: in `scan_grid`, `prior_grid`; out `map_grid`, `betp/<class>`, `decision`, `cells`, `objects`.
+ *
+ * Time: scans are fused in stamp order. A scan stamped 0, further ahead of the clock than
+ * future_tolerance, with the stamp of the last fused one, or older than it by at most time_jump_threshold
+ * is dropped and counted; only a genuine time jump (a scan older by more than that, or ROS time going back
+ * by more than that, as when a bag loops) resets the MapGrid, once, and clears the tf buffer. Diagnostics
+ * are published on a wall timer and describe the last diagnostic_window seconds.
+ */
 class FusionWorker
 {
 public:
@@ -47,7 +80,15 @@ public:
   ~FusionWorker();
 
 private:
+  void onScanIn(const EvidentialGrid::ConstPtr& msg);
   void onScan(const EvidentialGrid::ConstPtr& msg);
+  /// Clock watch on a wall timer: a backward jump resets once; transforms ahead of the clock are cleared.
+  void checkClock();
+  /// Resets the grid and the time state after a genuine jump; caller holds mutex_.
+  void resetForTimeJump(const std::string& why);
+  /// Counts a scan that will not be fused; caller holds mutex_.
+  void countLost(std::size_t& counter);
+  double wallNow() const;
   void onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason);
   void onPrior(const EvidentialGrid::ConstPtr& msg);
   void onReconfigure(FusionConfig& config, uint32_t level);
@@ -55,33 +96,36 @@ private:
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
-  std::string map_frame_, base_frame_;
-  bool publish_free_cells_ = false;
-  double object_box_height_ = 1.5;
+  FusionNodeParams node_params_;
 
   std::mutex mutex_;
   core::MapGrid grid_;
   std::optional<core::MapGridParams> pending_params_;
   std::shared_ptr<core::PriorWindow> prior_;
   bool warned_no_prior_ = false;
-  std::optional<ros::Time> last_stamp_;
+  core::StampGuard stamp_guard_;
+  core::ClockJumpDetector clock_jump_;
+  std::optional<core::Pose2> last_pose_;
+  double last_pose_stamp_ = 0.0;
+  std::string last_scan_frame_;
   FusionCounters counters_;
+  core::SlidingCounter fused_window_, lost_window_;
+  double start_wall_ = 0.0;
+  double last_fused_wall_ = 0.0;
   core::StageTimes last_times_;
   double last_total_seconds_ = 0.0;
   double last_mean_conflict_ = 0.0;
-  ros::WallTime last_scan_wall_;
-  double scan_rate_ = 0.0;
+  std::string last_reconfigure_ = "none";
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
-  message_filters::Subscriber<EvidentialGrid> scan_sub_;
   std::unique_ptr<tf2_ros::MessageFilter<EvidentialGrid>> scan_filter_;
-  ros::Subscriber prior_sub_;
+  ros::Subscriber scan_sub_, prior_sub_;
   ros::Publisher map_grid_pub_, decision_pub_, cells_pub_, objects_pub_;
   ros::Publisher betp_pub_[core::FrameMG::kSize];
   dynamic_reconfigure::Server<FusionConfig> reconfigure_;
-  diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  ros::WallTimer diagnostics_timer_, clock_timer_;
 };
 
 }  // namespace map_aided_fusion

@@ -14,9 +14,11 @@
  */
 #pragma once
 
+#include <memory>
 #include <mutex>
 #include <string>
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 
@@ -49,6 +51,8 @@ public:
 private:
   bool load();
   bool reload(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  /// Diagnostics: the file, what was kept and skipped, the published grid and its origin.
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void publish(const map_io::PriorGridParams& params, const core::VectorMap& map);
 
   ros::NodeHandle nh_;
@@ -61,6 +65,11 @@ private:
   core::PriorGrid grid_;
   bool loaded_ = false;
   std::string status_;
+  map_io::MapLoadReport report_;
+  core::GridGeometry published_;
+  std::size_t loads_ = 0;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  ros::WallTimer diagnostics_timer_;
 };
 
 }  // namespace map_aided_fusion

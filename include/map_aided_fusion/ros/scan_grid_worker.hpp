@@ -29,6 +29,8 @@
 
 #include "map_aided_fusion/ScanGridConfig.h"
 #include "map_aided_fusion/core/scan_grid.hpp"
+#include "map_aided_fusion/core/sliding_window.hpp"
+#include "map_aided_fusion/core/stamp_guard.hpp"
 
 namespace map_aided_fusion {
 
@@ -38,7 +40,9 @@ struct ScanGridNodeParams
   std::string base_frame = "base_link";  ///< frame of the published grids
   int input_queue_size = 2;              ///< clouds buffered by the subscriber (≥ 1)
   int tf_queue_size = 10;                ///< clouds waiting for their transform (≥ 1)
-  double diagnostic_period = 1.0;        ///< s between diagnostic reports (> 0)
+  double future_tolerance = 1.0;         ///< s a cloud may be stamped ahead of the clock, [0, 3600]
+  double time_jump_threshold = 1.0;      ///< s ROS time must go back by to count as a jump (tf buffer cleared)
+  core::StreamHealthParams health;       ///< diagnostic period, window and staleness
   core::ScanGridParams model;            ///< sensor model and grid, see core::ScanGridParams
 
   /// @throws core::ParameterError naming the first bad parameter.
@@ -79,6 +83,8 @@ private:
   void onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& cloud,
                           tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onReconfigure(ScanGridConfig& config, std::uint32_t level);
+  void checkClock();
+  double wallNow() const;
   void reject(const std::string& reason, const std::string& detail);
   /// A view of the cloud's x, y, z; false (rejected and counted) when the cloud cannot be read. Caller holds mutex_.
   bool viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCloudView& view);
@@ -94,14 +100,18 @@ private:
   ScanGridNodeCounters counters_;
   std::set<std::string> reported_;  // rejection reasons already logged as errors
 
-  // Diagnostics window.
-  std::size_t window_clouds_ = 0;
-  std::size_t window_rejected_ = 0;
+  // Diagnostics over the last health.diagnostic_window seconds (wall time).
+  core::SlidingCounter received_window_, published_window_, rejected_window_;
   double window_processing_sum_ = 0.0;
   double window_processing_max_ = 0.0;
   std::size_t window_processed_ = 0;
-  ros::WallTime window_start_;
+  double start_wall_ = 0.0;
+  double last_published_wall_ = 0.0;
   core::ScanGridStats last_stats_;
+  core::ClockJumpDetector clock_jump_;
+  std::size_t tf_clears_ = 0;
+  std::size_t reconfigure_refused_ = 0;
+  std::string last_reconfigure_ = "none";
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
@@ -111,7 +121,7 @@ private:
   ros::Subscriber cloud_sub_;
   ros::Publisher grid_pub_;
   ros::Publisher occupancy_pub_;
-  ros::WallTimer diagnostic_timer_;
+  ros::WallTimer diagnostic_timer_, clock_timer_;
 };
 
 }  // namespace map_aided_fusion

@@ -1,0 +1,134 @@
+/**
+ * @file sliding_window.hpp
+ * @brief Event counts over the last few seconds, for diagnostics that tell the truth about now rather
+ *        than about the whole history.
+ */
+#pragma once
+
+#include <cstddef>
+#include <deque>
+#include <string>
+
+namespace map_aided_fusion {
+namespace core {
+
+/**
+ * @brief Counts events whose time (seconds, any monotonic clock) lies in (now − span, now].
+ *
+ * Memory is bounded by the events in one span (older ones are pruned on every call).
+ */
+class SlidingCounter
+{
+public:
+  /// @param span window length, seconds (> 0)
+  explicit SlidingCounter(double span = 5.0) : span_(span) {}
+
+  void setSpan(double span) { span_ = span; }
+  double span() const { return span_; }
+
+  /// Records @p n events at time @p t.
+  void add(double t, std::size_t n = 1)
+  {
+    if (n == 0) return;
+    events_.push_back(Event{ t, n });
+    total_ += n;
+    prune(t);
+  }
+
+  /// Events in (now − span, now].
+  std::size_t count(double now)
+  {
+    prune(now);
+    return total_;
+  }
+
+  /// Events per second over the window; over the time since @p start when that is shorter than the span.
+  double rate(double now, double start)
+  {
+    const double elapsed = now - start;
+    const double window = elapsed < span_ ? elapsed : span_;
+    return window > 0.0 ? static_cast<double>(count(now)) / window : 0.0;
+  }
+
+  /// Time of the newest event, or @p none when the window holds none.
+  double newest(double none) const { return events_.empty() ? none : events_.back().t; }
+
+  void clear()
+  {
+    events_.clear();
+    total_ = 0;
+  }
+
+private:
+  struct Event
+  {
+    double t;
+    std::size_t n;
+  };
+  void prune(double now)
+  {
+    while (!events_.empty() && events_.front().t <= now - span_)
+    {
+      total_ -= events_.front().n;
+      events_.pop_front();
+    }
+  }
+
+  double span_;
+  std::deque<Event> events_;
+  std::size_t total_ = 0;
+};
+
+/// Parameters of the diagnostics of a node that expects a stream of scans (config/*.yaml).
+struct StreamHealthParams
+{
+  double diagnostic_period = 1.0;  ///< s between diagnostic messages, wall time, in [0.05, 60]
+  double diagnostic_window = 5.0;  ///< s of history the rates and counts cover, in [0.1, 600]
+  double stale_warn = 1.0;         ///< s without output before WARN, in (0, stale_error]
+  double stale_error = 3.0;        ///< s without output before ERROR, in [stale_warn, 3600]
+  /// @throws ParameterError naming the first parameter out of range.
+  void validate() const;
+};
+
+/// Calls get(name, field) for every parameter of @p p (the same names in every config/*.yaml).
+template <class Get>
+void forEachParam(StreamHealthParams& p, Get&& get)
+{
+  get("diagnostic_period", p.diagnostic_period);
+  get("diagnostic_window", p.diagnostic_window);
+  get("stale_warn", p.stale_warn);
+  get("stale_error", p.stale_error);
+}
+
+/// Severity of a diagnostic status, with diagnostic_msgs' numbering (OK 0, WARN 1, ERROR 2).
+enum class HealthLevel : int
+{
+  kOk = 0,
+  kWarn = 1,
+  kError = 2,
+};
+
+/// One diagnostic summary.
+struct HealthSummary
+{
+  HealthLevel level = HealthLevel::kOk;
+  std::string message;
+};
+
+/**
+ * @brief The summary of a stream over the last window.
+ * @param params           thresholds
+ * @param ever             true once the node produced any output
+ * @param since_last       seconds since the last output (ignored when !ever)
+ * @param produced         outputs in the window
+ * @param lost             inputs dropped or rejected in the window
+ * @param what             the noun for the outputs ("scans fused", "clouds published")
+ *
+ * ERROR when nothing came for stale_error; WARN when nothing came for stale_warn, before the first output,
+ * or when inputs were lost in the window; OK otherwise. The message says which and gives the numbers.
+ */
+HealthSummary streamHealth(const StreamHealthParams& params, bool ever, double since_last, std::size_t produced,
+                           std::size_t lost, const std::string& what);
+
+}  // namespace core
+}  // namespace map_aided_fusion

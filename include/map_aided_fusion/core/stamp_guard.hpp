@@ -1,0 +1,111 @@
+/**
+ * @file stamp_guard.hpp
+ * @brief Time hygiene of a stream of scans, ROS-free: which scan may be fused, which is dropped, and when
+ *        time really jumped back (a looping bag, a restarted `/clock`) so that the MapGrid must start again.
+ *
+ * Accumulated evidence is only thrown away on a genuine time jump: an out-of-order scan (a second lidar on
+ * the same topic, a large cloud that arrives late, scans a tf message filter releases newest first) is
+ * dropped and counted; a scan stamped 0 or twice with the same stamp is dropped and counted.
+ */
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace map_aided_fusion {
+namespace core {
+
+/// Parameters of StampGuard, ClockJumpDetector and PoseJumpCheck (config/fusion.yaml).
+struct TimeGuardParams
+{
+  /**
+   * A scan older than the last fused one by more than this (s) is a time jump: the grid is reset and the
+   * scan fused. Older by less (or equal): out of order, dropped. In [0.001, 3600].
+   */
+  double time_jump_threshold = 1.0;
+  /// Vehicle speeds above this between two fused scans (m/s) are reported as a pose jump. In (0, 1000].
+  double max_plausible_speed = 70.0;
+  /// @throws ParameterError naming the first parameter out of range.
+  void validate() const;
+};
+
+/// Calls get(name, field) for every parameter of @p p, with the names of config/fusion.yaml.
+template <class Get>
+void forEachParam(TimeGuardParams& p, Get&& get)
+{
+  get("time_jump_threshold", p.time_jump_threshold);
+  get("max_plausible_speed", p.max_plausible_speed);
+}
+
+/// What to do with a scan.
+enum class StampVerdict
+{
+  kFuse,        ///< newer than the last fused scan (or the first one)
+  kZeroStamp,   ///< stamped 0 (or negative, or not finite): no pose can be looked up for it
+  kDuplicate,   ///< the same stamp as the last fused scan
+  kOutOfOrder,  ///< older than the last fused scan by at most time_jump_threshold
+  kTimeJump,    ///< older by more than time_jump_threshold: reset, then fuse
+};
+
+/// A short name for logs and diagnostics ("fuse", "zero stamp", "duplicate stamp", "out of order", "time jump").
+const char* toString(StampVerdict v);
+
+/**
+ * @brief Classifies scan stamps against the last fused one.
+ *
+ * check() does not change the state; the caller calls accept() once the scan is fused, and reset() when
+ * the grid is reset for any other reason (a /clock jump).
+ */
+class StampGuard
+{
+public:
+  explicit StampGuard(const TimeGuardParams& params = TimeGuardParams{}) : params_(params) {}
+  void setParams(const TimeGuardParams& params) { params_ = params; }
+
+  /// The verdict for a scan stamped @p stamp (seconds).
+  StampVerdict check(double stamp) const;
+  /// Records @p stamp as the last fused scan.
+  void accept(double stamp) { last_ = stamp; }
+  /// Forgets the last fused stamp: the next scan is fused whatever its stamp (but 0).
+  void reset() { last_.reset(); }
+  const std::optional<double>& last() const { return last_; }
+
+private:
+  TimeGuardParams params_;
+  std::optional<double> last_;
+};
+
+/**
+ * @brief Watches a clock (ROS time, i.e. `/clock` under simulated time) for backward jumps.
+ *
+ * observe() is called with the clock's value now and then (a wall timer, every scan); it returns true once
+ * per jump, when the clock is more than the threshold behind the latest value it saw.
+ */
+class ClockJumpDetector
+{
+public:
+  explicit ClockJumpDetector(double threshold = TimeGuardParams{}.time_jump_threshold) : threshold_(threshold) {}
+  void setThreshold(double threshold) { threshold_ = threshold; }
+  /// True when @p now (seconds) is more than the threshold behind the latest value observed.
+  bool observe(double now);
+  std::size_t jumps() const { return jumps_; }
+
+private:
+  double threshold_;
+  std::optional<double> latest_;
+  std::size_t jumps_ = 0;
+};
+
+/// Implied speed between two fused poses, for a warning when localisation jumps.
+struct PoseJump
+{
+  bool jumped = false;   ///< speed above TimeGuardParams::max_plausible_speed
+  double distance = 0.0; ///< metres between the two poses
+  double speed = 0.0;    ///< metres per second (infinite when dt ≤ 0)
+};
+
+/// Distance and speed between (x0, y0) at t0 and (x1, y1) at t1, judged against @p max_speed.
+PoseJump checkPoseJump(double x0, double y0, double t0, double x1, double y1, double t1, double max_speed);
+
+}  // namespace core
+}  // namespace map_aided_fusion

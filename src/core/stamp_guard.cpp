@@ -1,0 +1,76 @@
+#include "map_aided_fusion/core/stamp_guard.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "map_aided_fusion/core/parameters.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+namespace {
+
+constexpr double kMinJumpThreshold = 0.001;
+constexpr double kMaxJumpThreshold = 3600.0;
+constexpr double kMaxSpeed = 1000.0;
+
+}  // namespace
+
+void TimeGuardParams::validate() const
+{
+  requireInRange("time_jump_threshold", time_jump_threshold, kMinJumpThreshold, kMaxJumpThreshold);
+  requireInRange("max_plausible_speed", max_plausible_speed, std::numeric_limits<double>::min(), kMaxSpeed);
+}
+
+const char* toString(StampVerdict v)
+{
+  switch (v)
+  {
+    case StampVerdict::kFuse:
+      return "fuse";
+    case StampVerdict::kZeroStamp:
+      return "zero stamp";
+    case StampVerdict::kDuplicate:
+      return "duplicate stamp";
+    case StampVerdict::kOutOfOrder:
+      return "out of order";
+    case StampVerdict::kTimeJump:
+      return "time jump";
+  }
+  return "unknown";
+}
+
+StampVerdict StampGuard::check(double stamp) const
+{
+  if (!std::isfinite(stamp) || stamp <= 0.0) return StampVerdict::kZeroStamp;
+  if (!last_) return StampVerdict::kFuse;
+  if (stamp > *last_) return StampVerdict::kFuse;
+  if (stamp == *last_) return StampVerdict::kDuplicate;
+  return *last_ - stamp > params_.time_jump_threshold ? StampVerdict::kTimeJump : StampVerdict::kOutOfOrder;
+}
+
+bool ClockJumpDetector::observe(double now)
+{
+  if (!std::isfinite(now)) return false;
+  if (latest_ && *latest_ - now > threshold_)
+  {
+    latest_ = now;
+    ++jumps_;
+    return true;
+  }
+  if (!latest_ || now > *latest_) latest_ = now;
+  return false;
+}
+
+PoseJump checkPoseJump(double x0, double y0, double t0, double x1, double y1, double t1, double max_speed)
+{
+  PoseJump j;
+  j.distance = std::hypot(x1 - x0, y1 - y0);
+  const double dt = t1 - t0;
+  j.speed = dt > 0.0 ? j.distance / dt : (j.distance > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
+  j.jumped = j.speed > max_speed;
+  return j;
+}
+
+}  // namespace core
+}  // namespace map_aided_fusion

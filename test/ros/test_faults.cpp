@@ -1,0 +1,434 @@
+// rostests of the pipeline under faults (launch/map_aided_fusion.launch in one manager, a synthetic lidar):
+// one test per fault of the "never throw evidence away" issue. test/faults.test runs Faults.* on wall time;
+// test/bag_loop.test runs BagLoop.* under simulated time, replaying a recorded drive three times in a loop.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <dynamic_reconfigure/Reconfigure.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include "synthetic_lidar.hpp"
+
+namespace {
+
+using maf_test::Box;
+using maf_test::kLidarHeight;
+using maf_test::makeCloud;
+
+constexpr double kScanPeriod = 0.1;
+constexpr double kSettle = 2.5;  // s: more than two diagnostic periods
+
+/// What the three nodelets report on /diagnostics, by status (name fragment) then key.
+class Probe
+{
+public:
+  Probe()
+  {
+    ros::NodeHandle nh;
+    points_ = nh.advertise<sensor_msgs::PointCloud2>("points", 20);
+    tf_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
+    diagnostics_ = nh.subscribe("/diagnostics", 100, &Probe::onDiagnostics, this);
+    decision_ = nh.subscribe("/map_aided_fusion/decision", 5, &Probe::onDecision, this);
+    geometry_msgs::TransformStamped lidar;
+    lidar.header.frame_id = "base_link";
+    lidar.child_frame_id = "lidar";
+    lidar.transform.translation.z = kLidarHeight;
+    lidar.transform.rotation.w = 1.0;
+    static_broadcaster_.sendTransform(lidar);
+  }
+
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& m)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& s : m->status)
+    {
+      const std::string who = s.name.find("fusion") != std::string::npos   ? "fusion" :
+                              s.name.find("ScanGrid") != std::string::npos  ? "scan_grid" :
+                              s.name.find("PriorGrid") != std::string::npos ? "prior_grid" :
+                                                                              "";
+      if (who.empty()) continue;
+      auto& d = values_[who];
+      for (const auto& kv : s.values) d[kv.key] = kv.value;
+      level_[who] = s.level;
+      message_[who] = s.message;
+      ++messages_[who];
+    }
+  }
+  void onDecision(const nav_msgs::OccupancyGrid::ConstPtr& m)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    known_cells_ = 0;
+    for (const auto v : m->data) known_cells_ += v >= 0;
+  }
+
+  /// A numeric diagnostic value, or −1 when not received.
+  double value(const std::string& who, const std::string& key)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto w = values_.find(who);
+    if (w == values_.end()) return -1.0;
+    auto it = w->second.find(key);
+    if (it == w->second.end()) return -1.0;
+    try
+    {
+      return std::stod(it->second);
+    }
+    catch (const std::exception&)
+    {
+      return -1.0;
+    }
+  }
+  std::string text(const std::string& who, const std::string& key)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return values_[who][key];
+  }
+  int level(const std::string& who)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return level_.count(who) ? level_[who] : -1;
+  }
+  std::string message(const std::string& who)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return message_[who];
+  }
+  std::size_t messages(const std::string& who)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return messages_[who];
+  }
+  std::size_t knownCells()
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return known_cells_;
+  }
+
+  void sendPose(const ros::Time& stamp, double x = 0.0)
+  {
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = "map";
+    t.header.stamp = stamp;
+    t.child_frame_id = "base_link";
+    t.transform.translation.x = x;
+    t.transform.rotation.w = 1.0;
+    tf2_msgs::TFMessage m;
+    m.transforms.push_back(t);
+    tf_.publish(m);
+  }
+  void sendCloud(const ros::Time& stamp, const std::string& frame = "lidar")
+  {
+    points_.publish(makeCloud({ Box{ 8.0, 3.0, 12.5, 5.0, 1.5 } }, stamp, frame));
+  }
+
+  /// Spins on wall time while @p done is false, at most @p seconds; true when done.
+  template <class F>
+  bool waitFor(F&& done, double seconds)
+  {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < end)
+    {
+      if (done()) return true;
+      ros::spinOnce();
+      ros::WallDuration(0.01).sleep();
+    }
+    return done();
+  }
+  void spinFor(double seconds)
+  {
+    waitFor([] { return false; }, seconds);
+  }
+
+  ros::Publisher points_, tf_;
+
+private:
+  ros::Subscriber diagnostics_, decision_;
+  tf2_ros::StaticTransformBroadcaster static_broadcaster_;
+  std::mutex mutex_;
+  std::map<std::string, std::map<std::string, std::string>> values_;
+  std::map<std::string, int> level_;
+  std::map<std::string, std::string> message_;
+  std::map<std::string, std::size_t> messages_;
+  std::size_t known_cells_ = 0;
+};
+
+Probe* probe = nullptr;
+ros::Time last_stamp;  ///< stamp of the last cloud sent in order (wall-time tests)
+
+/// Sends @p n scans at 10 Hz, stamped when sent, with their poses; waits until the fusion counted them.
+void drive(int n)
+{
+  const double fused0 = probe->value("fusion", "scans fused");
+  for (int k = 0; k < n; ++k)
+  {
+    last_stamp = ros::Time::now();
+    probe->sendPose(last_stamp);
+    probe->spinFor(0.02);
+    probe->sendCloud(last_stamp);
+    probe->spinFor(kScanPeriod);
+  }
+  probe->sendPose(ros::Time::now());
+  probe->waitFor([&] { return probe->value("fusion", "scans fused") >= fused0 + n - 1; }, 5.0);
+}
+
+void setUpPipeline()
+{
+  ASSERT_TRUE(probe->waitFor([] { return probe->points_.getNumSubscribers() > 0; }, 30.0)) << "no subscriber";
+  probe->spinFor(1.0);
+  if (probe->value("fusion", "scans fused") < 10.0) drive(20);
+  ASSERT_GE(probe->value("fusion", "scans fused"), 10.0) << "the pipeline does not fuse";
+}
+
+// ------------------------------------------------------------------------------------------------
+// Wall time (test/faults.test)
+// ------------------------------------------------------------------------------------------------
+
+TEST(Faults, Item1_OutOfOrderScanIsDroppedAndCountedNotAReset)
+{
+  setUpPipeline();
+  const double resets = probe->value("fusion", "grid resets (time jump)");
+  const double out_of_order = probe->value("fusion", "scans dropped (out of order)");
+  const std::size_t known = probe->knownCells();
+  ASSERT_GT(known, 100u);
+  probe->sendCloud(last_stamp - ros::Duration(0.05));  // 50 ms late, as from a second lidar
+  EXPECT_TRUE(probe->waitFor(
+      [&] { return probe->value("fusion", "scans dropped (out of order)") == out_of_order + 1.0; }, kSettle))
+      << "out of order: " << probe->value("fusion", "scans dropped (out of order)");
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), resets);
+  drive(3);
+  EXPECT_GE(probe->knownCells(), known * 9 / 10) << "evidence was thrown away";
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), resets);
+}
+
+TEST(Faults, Item2_CloudStampedZeroIsRejectedAndCounted)
+{
+  setUpPipeline();
+  const double rejected = probe->value("scan_grid", "clouds rejected: zero_stamp");
+  const double resets = probe->value("fusion", "grid resets (time jump)");
+  probe->sendCloud(ros::Time(0));
+  EXPECT_TRUE(probe->waitFor(
+      [&] { return probe->value("scan_grid", "clouds rejected: zero_stamp") == std::max(0.0, rejected) + 1.0; },
+      kSettle));
+  drive(2);
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), resets);
+}
+
+TEST(Faults, Item3_ScansReleasedAfterATfGapNeverReset)
+{
+  setUpPipeline();
+  const double resets = probe->value("fusion", "grid resets (time jump)");
+  const double fused = probe->value("fusion", "scans fused");
+  const double out_of_order = probe->value("fusion", "scans dropped (out of order)");
+  // A tf gap: three clouds wait for their transform, then one pose after them releases them all.
+  const ros::Time t0 = ros::Time::now();
+  for (int k = 1; k <= 3; ++k)
+  {
+    probe->sendCloud(t0 + ros::Duration(0.1 * k));
+    probe->spinFor(kScanPeriod);
+  }
+  probe->spinFor(0.3);
+  probe->sendPose(t0 + ros::Duration(0.45));
+  EXPECT_TRUE(probe->waitFor(
+      [&] {
+        return probe->value("fusion", "scans fused") + probe->value("fusion", "scans dropped (out of order)") ==
+               fused + out_of_order + 3.0;
+      },
+      kSettle))
+      << "fused " << probe->value("fusion", "scans fused") - fused << ", out of order "
+      << probe->value("fusion", "scans dropped (out of order)") - out_of_order;
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), resets);
+  last_stamp = t0 + ros::Duration(0.3);
+}
+
+TEST(Faults, Item5_DiagnosticsTellTheLastSecondsAndTheMapLoaderReports)
+{
+  setUpPipeline();
+  drive(10);
+  probe->spinFor(1.2);
+  EXPECT_GT(probe->value("fusion", "scan rate [Hz]"), 1.0);
+  // Scans stop: within the staleness thresholds the status goes WARN then ERROR and the rate decays.
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion") == diagnostic_msgs::DiagnosticStatus::ERROR; }, 6.0))
+      << probe->message("fusion");
+  EXPECT_TRUE(probe->waitFor([] { return probe->value("fusion", "scan rate [Hz]") == 0.0; }, 4.0))
+      << "rate " << probe->value("fusion", "scan rate [Hz]");
+  // Scans resume without loss: OK again (a drop long ago does not keep it WARN).
+  drive(15);
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion") == diagnostic_msgs::DiagnosticStatus::OK; }, 2.0))
+      << probe->message("fusion");
+  // The map loader has diagnostics of its own.
+  EXPECT_GT(probe->messages("prior_grid"), 0u);
+  EXPECT_GT(probe->value("prior_grid", "buildings kept"), 0.0);
+  EXPECT_NE(probe->text("prior_grid", "file").find("town.osm"), std::string::npos);
+  EXPECT_NE(probe->text("prior_grid", "grid [cells]").find(" x "), std::string::npos);
+}
+
+dynamic_reconfigure::Config reconfigure(const std::string& service, const std::string& name, double value)
+{
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::DoubleParameter d;
+  d.name = name;
+  d.value = value;
+  srv.request.config.doubles.push_back(d);
+  EXPECT_TRUE(ros::service::waitForService(service, ros::Duration(10.0))) << service;
+  EXPECT_TRUE(ros::service::call(service, srv)) << service;
+  return srv.response.config;
+}
+
+double doubleOf(const dynamic_reconfigure::Config& c, const std::string& name)
+{
+  for (const auto& d : c.doubles)
+    if (d.name == name) return d.value;
+  return std::nan("");
+}
+
+TEST(Faults, Item6_ReconfigureRepliesWithTheValuesInForce)
+{
+  setUpPipeline();
+  const std::string scan = "/map_aided_fusion/scan_grid/set_parameters";
+  EXPECT_EQ(doubleOf(reconfigure(scan, "min_range", 90.0), "min_range"), 1.0) << "min_range above max_range shown";
+  EXPECT_EQ(doubleOf(reconfigure(scan, "mu_free", 0.6), "mu_free"), 0.6) << "a valid change after a refusal";
+  EXPECT_EQ(doubleOf(reconfigure(scan, "min_range", 2.0), "min_range"), 2.0);
+  const std::string fusion = "/map_aided_fusion/fusion/set_parameters";
+  for (const double bad : { 5.0, -1.0, std::numeric_limits<double>::infinity(), std::nan("") })
+    EXPECT_EQ(doubleOf(reconfigure(fusion, "alpha_static", bad), "alpha_static"), 0.02) << "alpha_static " << bad;
+  EXPECT_EQ(doubleOf(reconfigure(fusion, "alpha_static", 0.05), "alpha_static"), 0.05);
+  probe->spinFor(kSettle);
+  EXPECT_GE(probe->value("fusion", "reconfigure refused"), 4.0);
+  EXPECT_GE(probe->value("scan_grid", "reconfigure refused"), 1.0);
+  reconfigure(fusion, "alpha_static", 0.02);
+  reconfigure(scan, "min_range", 1.0);
+  reconfigure(scan, "mu_free", 0.7);
+}
+
+TEST(Faults, Item7_HugeWindowIsRefusedAndTheManagerKeepsWorking)
+{
+  setUpPipeline();
+  // test/faults.test loads a second FusionNodelet with a 12 GB window into the same manager.
+  ros::NodeHandle nh;
+  EXPECT_FALSE(ros::service::exists("/map_aided_fusion/fusion_huge/set_parameters", false))
+      << "the huge fusion nodelet started";
+  const double fused = probe->value("fusion", "scans fused");
+  drive(5);
+  EXPECT_GE(probe->value("fusion", "scans fused"), fused + 4.0) << "the manager stopped fusing";
+}
+
+TEST(Faults, Item8_FusionNodeWithABadParameterSaysWhy)
+{
+  const std::string cmd = std::string(MAF_FUSION_NODE) + " __name:=bad_fusion _resolution:=-1 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buf[512];
+  while (fgets(buf, sizeof buf, pipe)) out += buf;
+  const int status = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << "status " << status;
+  EXPECT_NE(out.find("resolution"), std::string::npos) << "printed: " << out;
+}
+
+TEST(Faults, Item11_FutureDuplicatePoseJumpAreCounted)
+{
+  setUpPipeline();
+  const double future = std::max(0.0, probe->value("scan_grid", "clouds rejected: future_stamp"));
+  probe->sendCloud(ros::Time::now() + ros::Duration(3600.0));
+  EXPECT_TRUE(probe->waitFor(
+      [&] { return probe->value("scan_grid", "clouds rejected: future_stamp") == future + 1.0; }, kSettle));
+
+  drive(3);
+  const double duplicate = probe->value("fusion", "scans dropped (duplicate stamp)");
+  probe->sendCloud(last_stamp);  // the same stamp again
+  EXPECT_TRUE(probe->waitFor(
+      [&] { return probe->value("fusion", "scans dropped (duplicate stamp)") == duplicate + 1.0; }, kSettle));
+
+  const double jumps = probe->value("fusion", "pose jumps");
+  const ros::Time t = ros::Time::now();
+  probe->sendPose(t, 500.0);  // 500 m in a tenth of a second
+  probe->spinFor(0.02);
+  probe->sendCloud(t);
+  probe->spinFor(0.1);
+  probe->sendPose(ros::Time::now(), 500.0);
+  EXPECT_TRUE(probe->waitFor([&] { return probe->value("fusion", "pose jumps") == jumps + 1.0; }, kSettle));
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Simulated time (test/bag_loop.test): a 3 s drive recorded once, replayed three times with /clock going back
+// at each loop, as `rosbag play --clock --loop` does; a transform from the end of a loop arrives after the
+// jump, as it did with the real bag.
+// ------------------------------------------------------------------------------------------------
+
+TEST(BagLoop, ThreeLoopsResetOnceEachAndLoseNoScan)
+{
+  ros::NodeHandle nh;
+  ros::Publisher clock = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  ASSERT_TRUE(probe->waitFor([] { return probe->points_.getNumSubscribers() > 0; }, 30.0));
+  constexpr double kStart = 1000.0;
+  constexpr int kScansPerLoop = 30;
+  // Simulated time runs 5x faster than the wall: a 15 s loop, longer than tf's 10 s cache, as in the real bag
+  // whose new loop's transforms tf ignored as too old.
+  constexpr double kSimPeriod = 0.5;
+  auto tick = [&](double t) {
+    rosgraph_msgs::Clock c;
+    c.clock = ros::Time(t);
+    clock.publish(c);
+  };
+  tick(kStart);
+  probe->spinFor(1.0);
+  std::vector<double> fused_per_loop;
+  double fused_before = 0.0;
+  for (int loop = 0; loop < 3; ++loop)
+  {
+    for (int k = 0; k < kScansPerLoop; ++k)
+    {
+      const double t = kStart + kSimPeriod * k;
+      tick(t);
+      probe->sendPose(ros::Time(t), 0.5 * k * kSimPeriod);
+      probe->spinFor(0.02);
+      probe->sendCloud(ros::Time(t));
+      probe->spinFor(kScanPeriod);
+      if (loop > 0 && k == 1)
+        probe->sendPose(ros::Time(kStart + kSimPeriod * (kScansPerLoop + 1)), 0.0);  // late tf of the last loop
+    }
+    tick(kStart + kSimPeriod * kScansPerLoop);
+    probe->sendPose(ros::Time(kStart + kSimPeriod * kScansPerLoop), 0.5 * kScansPerLoop * kSimPeriod);
+    probe->spinFor(1.5);
+    const double fused = probe->value("fusion", "scans fused");
+    fused_per_loop.push_back(fused - fused_before);
+    fused_before = fused;
+  }
+  for (std::size_t l = 0; l < fused_per_loop.size(); ++l)
+    EXPECT_GE(fused_per_loop[l], kScansPerLoop - 3) << "loop " << l << " fused " << fused_per_loop[l] << " scans";
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 2.0) << "one reset per backward jump";
+  EXPECT_EQ(probe->value("fusion", "scans dropped (out of order)"), 0.0);
+  // Diagnostics kept coming after the clock went back (they are on a wall timer) and tell the truth.
+  const std::size_t n = probe->messages("fusion");
+  probe->spinFor(2.5);
+  EXPECT_GE(probe->messages("fusion"), n + 2) << "diagnostics stopped";
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion") != diagnostic_msgs::DiagnosticStatus::OK; }, 4.0))
+      << "OK while nothing is fused: " << probe->message("fusion");
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_faults");
+  ros::NodeHandle nh;
+  Probe p;
+  probe = &p;
+  return RUN_ALL_TESTS();
+}
