@@ -56,10 +56,14 @@ public:
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& s : m->status)
     {
-      const std::string who = s.name.find("fusion") != std::string::npos   ? "fusion" :
-                              s.name.find("ScanGrid") != std::string::npos  ? "scan_grid" :
-                              s.name.find("PriorGrid") != std::string::npos ? "prior_grid" :
-                                                                              "";
+      // Names are "<node namespace>: <task>"; every namespace holds "map_aided_fusion".
+      auto endsWith = [&](const std::string& tail) {
+        return s.name.size() >= tail.size() && s.name.compare(s.name.size() - tail.size(), tail.size(), tail) == 0;
+      };
+      const std::string who = endsWith(": fusion")    ? "fusion" :
+                              endsWith(": ScanGrid")  ? "scan_grid" :
+                              endsWith(": PriorGrid") ? "prior_grid" :
+                                                        "";
       if (who.empty()) continue;
       auto& d = values_[who];
       for (const auto& kv : s.values) d[kv.key] = kv.value;
