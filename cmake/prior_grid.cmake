@@ -48,7 +48,9 @@ if(CATKIN_ENABLE_TESTING)
   target_include_directories(test_map_loader SYSTEM PRIVATE ${GeographicLib_INCLUDE_DIRS} ${GDAL_INCLUDE_DIRS})
   target_compile_definitions(test_map_loader PRIVATE
     MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data"
-    MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+    MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    MAF_PRIOR_GRID_TOOL="$<TARGET_FILE:prior_grid_tool>")
+  add_dependencies(test_map_loader prior_grid_tool)
 
   catkin_add_gtest(test_prior_grid_params test/prior/test_prior_grid_params.cpp test/test_main.cpp)
   target_link_libraries(test_prior_grid_params map_aided_fusion_map_io yaml-cpp)

@@ -280,7 +280,9 @@ TEST(Soak, HundredThousandNoisyScansKeepMassFunctionsAndFlatMemory)
   const long growth = residentKb() - rss_after_warmup;
   std::cout << "soak: " << kScans << " scans, |sum - 1| <= " << worst_sum << ", min mass " << worst_negative
             << ", RSS growth after warm-up " << growth << " kB\n";
+#ifndef __SANITIZE_ADDRESS__  // AddressSanitizer's quarantine keeps freed memory resident
   EXPECT_LT(growth, 1024) << "memory grew by " << growth << " kB";
+#endif
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
@@ -80,6 +81,17 @@ inline sensor_msgs::PointCloud2 makeCloud(const std::vector<Box>& boxes, const r
     it[2] = xyz[i + 2];
   }
   return cloud;
+}
+
+/// The static transform base_link → lidar (kLidarHeight above, no rotation).
+inline geometry_msgs::TransformStamped lidarMount()
+{
+  geometry_msgs::TransformStamped lidar;
+  lidar.header.frame_id = "base_link";
+  lidar.child_frame_id = "lidar";
+  lidar.transform.translation.z = kLidarHeight;
+  lidar.transform.rotation.w = 1.0;
+  return lidar;
 }
 
 }  // namespace maf_test

@@ -8,7 +8,6 @@
 #include <map>
 #include <mutex>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -21,12 +20,12 @@
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "../run_command.hpp"
 #include "synthetic_lidar.hpp"
 
 namespace {
 
 using maf_test::Box;
-using maf_test::kLidarHeight;
 using maf_test::makeCloud;
 
 constexpr double kScanPeriod = 0.1;
@@ -43,12 +42,7 @@ public:
     tf_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
     diagnostics_ = nh.subscribe("/diagnostics", 100, &Probe::onDiagnostics, this);
     decision_ = nh.subscribe("/map_aided_fusion/decision", 5, &Probe::onDecision, this);
-    geometry_msgs::TransformStamped lidar;
-    lidar.header.frame_id = "base_link";
-    lidar.child_frame_id = "lidar";
-    lidar.transform.translation.z = kLidarHeight;
-    lidar.transform.rotation.w = 1.0;
-    static_broadcaster_.sendTransform(lidar);
+    static_broadcaster_.sendTransform(maf_test::lidarMount());
   }
 
   void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& m)
@@ -332,14 +326,10 @@ TEST(Faults, Item7_HugeWindowIsRefusedAndTheManagerKeepsWorking)
 
 TEST(Faults, Item8_FusionNodeWithABadParameterSaysWhy)
 {
-  const std::string cmd = std::string(MAF_FUSION_NODE) + " __name:=bad_fusion _resolution:=-1 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string out;
-  char buf[512];
-  while (fgets(buf, sizeof buf, pipe)) out += buf;
-  const int status = pclose(pipe);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << "status " << status;
+  int status = 0;
+  const std::string out =
+      maf_test::runCommand(std::string(MAF_FUSION_NODE) + " __name:=bad_fusion _resolution:=-1", &status);
+  EXPECT_EQ(status, 1);
   EXPECT_NE(out.find("resolution"), std::string::npos) << "printed: " << out;
 }
 

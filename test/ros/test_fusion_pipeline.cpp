@@ -27,7 +27,6 @@
 namespace {
 
 using maf_test::Box;
-using maf_test::kLidarHeight;
 using maf_test::makeCloud;
 constexpr double kScanPeriod = 0.1;
 
@@ -45,12 +44,7 @@ protected:
     objects_sub_ = nh_.subscribe("objects", 10, &PipelineTest::onObjects, this);
     decision_sub_ = nh_.subscribe("decision", 10, &PipelineTest::onDecision, this);
     diagnostics_sub_ = nh_.subscribe("/diagnostics", 50, &PipelineTest::onDiagnostics, this);
-    geometry_msgs::TransformStamped lidar;
-    lidar.header.frame_id = "base_link";
-    lidar.child_frame_id = "lidar";
-    lidar.transform.translation.z = kLidarHeight;
-    lidar.transform.rotation.w = 1.0;
-    static_broadcaster_.sendTransform(lidar);
+    static_broadcaster_.sendTransform(maf_test::lidarMount());
   }
 
   void onObjects(const visualization_msgs::MarkerArray::ConstPtr& m)
