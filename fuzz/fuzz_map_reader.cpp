@@ -1,14 +1,13 @@
-// libFuzzer target: bytes -> a temporary map file -> loadVectorMap (GDAL/OGR + GeographicLib) -> PriorGrid.
+// libFuzzer target: bytes -> an in-memory map file (GDAL /vsimem/) -> loadVectorMap (GDAL/OGR + GeographicLib)
+// -> PriorGrid.
 // The first byte picks the format (OSM XML or GeoJSON) and whether the coordinates are metric. Built and run
 // by scripts/fuzz; every crash found becomes a unit test (test/prior/test_reader_faults.cpp).
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include <cpl_error.h>
+#include <cpl_vsi.h>
 
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
@@ -32,11 +31,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)quiet;
   const std::uint8_t mode = data[0];
   const std::string ext = (mode & 1) ? ".geojson" : ".osm";
-  const std::string path = "/tmp/maf_fuzz_map_" + std::to_string(getpid()) + ext;
-  {
-    std::ofstream f(path, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
-  }
+  const std::string path = "/vsimem/maf_fuzz_map" + ext;
+  VSIFCloseL(VSIFileFromMemBuffer(path.c_str(), const_cast<GByte*>(data + 1), static_cast<vsi_l_offset>(size - 1),
+                                  FALSE));
   map_io::MapLoadParams p;
   p.file = path;
   p.metric = (mode & 2) != 0;
@@ -61,6 +58,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   catch (const core::ParameterError&)
   {
   }
-  std::remove(path.c_str());
+  VSIUnlink(path.c_str());
   return 0;
 }

@@ -280,7 +280,11 @@ private:
   void open()
   {
     std::error_code ec;
-    if (!std::filesystem::exists(p_.file, ec)) fail("file does not exist");
+    // GDAL's virtual file systems (/vsizip/, /vsimem/, ...) are paths too.
+    VSIStatBufL stat;
+    const bool virtual_path = p_.file.rfind("/vsi", 0) == 0;
+    if (virtual_path ? VSIStatL(p_.file.c_str(), &stat) != 0 : !std::filesystem::exists(p_.file, ec))
+      fail("file does not exist");
     kind_ = p_.source == MapSourceKind::kAuto ? kindFromExtension(p_.file) : p_.source;
     std::vector<const char*> drivers;
     std::vector<std::string> options;

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include <cpl_vsi.h>
+
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/core/rasterizer.hpp"
@@ -242,6 +244,19 @@ TEST(MapReaderFaults, OriginParametersAreCheckedWithClearNames)
   p.origin_longitude = 2.0;
   p.max_vertices_per_feature = 2;
   EXPECT_THROW(p.validate(), core::ParameterError);
+}
+
+TEST(MapReaderFaults, GdalVirtualPathsAreReadable)
+{
+  std::string json = featureCollection(building("[[0,0],[10,0],[10,10],[0,10],[0,0]]"));
+  VSIFCloseL(VSIFileFromMemBuffer("/vsimem/maf_test.geojson", reinterpret_cast<GByte*>(&json[0]),
+                                  static_cast<vsi_l_offset>(json.size()), FALSE));
+  map_io::MapLoadParams p;
+  p.metric = true;
+  p.file = "/vsimem/maf_test.geojson";
+  EXPECT_EQ(map_io::loadVectorMap(p).buildings.size(), 1u);
+  VSIUnlink("/vsimem/maf_test.geojson");
+  EXPECT_THROW(map_io::loadVectorMap(p), map_io::MapLoadError);
 }
 
 TEST(PriorGridToolFaults, NonFiniteNumbersAreBadOptionsNotDisabledLimits)
