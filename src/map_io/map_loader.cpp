@@ -685,10 +685,10 @@ private:
         skipDegenerate(id, "coordinates not finite or beyond 1e9 in the source CRS");
         continue;
       }
-      if (vertexCount(g) > static_cast<std::size_t>(p_.max_vertices_per_feature))
+      if (const std::size_t vertices = vertexCount(g); vertices > static_cast<std::size_t>(p_.max_vertices_per_feature))
       {
         ++r_.skipped_too_many_vertices;
-        note(id, std::to_string(vertexCount(g)) + " vertices, more than max_vertices_per_feature = " +
+        note(id, std::to_string(vertices) + " vertices, more than max_vertices_per_feature = " +
                      std::to_string(p_.max_vertices_per_feature));
         continue;
       }

@@ -78,7 +78,7 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   , tf_listener_(tf_buffer_, nh)
   , reconfigure_(pnh)
 {
-  start_wall_ = wallNow();
+  start_wall_ = core::steadySeconds();
   map_grid_pub_ = nh_.advertise<EvidentialGrid>("map_grid", 1);
   for (int e = 0; e < core::FrameMG::kSize; ++e) betp_pub_[e] = nh_.advertise<nav_msgs::OccupancyGrid>(kBetpTopics[e], 1);
   decision_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("decision", 1);
@@ -114,11 +114,6 @@ FusionWorker::~FusionWorker()
   clock_timer_.stop();
   diagnostics_timer_.stop();
   scan_sub_.shutdown();
-}
-
-double FusionWorker::wallNow() const
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 namespace {
@@ -199,7 +194,7 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
 void FusionWorker::countLost(std::size_t& counter)
 {
   ++counter;
-  lost_window_.add(wallNow());
+  lost_window_.add(core::steadySeconds());
 }
 
 void FusionWorker::onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason)
@@ -391,12 +386,13 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   }
   if (last_pose_)
   {
-    const core::PoseJump j = core::checkPoseJump(last_pose_->x, last_pose_->y, last_pose_stamp_, pose.x, pose.y,
-                                                 stamp, node_params_.time.max_plausible_speed);
+    const double last_stamp = *stamp_guard_.last();  // set with last_pose_, reset with it
+    const core::PoseJump j = core::checkPoseJump(last_pose_->x, last_pose_->y, last_stamp, pose.x, pose.y, stamp,
+                                                 node_params_.time.max_plausible_speed);
     if (j.jumped)
     {
       ++counters_.pose_jumps;
-      ROS_WARN_STREAM("fusion: the vehicle moved " << j.distance << " m in " << stamp - last_pose_stamp_ << " s ("
+      ROS_WARN_STREAM("fusion: the vehicle moved " << j.distance << " m in " << stamp - last_stamp << " s ("
                                                    << j.speed << " m/s, max_plausible_speed "
                                                    << node_params_.time.max_plausible_speed
                                                    << "): a localisation jump? Evidence is kept where the window "
@@ -412,9 +408,8 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   const auto stats = grid_.update(scan, pose, stamp, prior_.get(), &times);
   stamp_guard_.accept(stamp);
   last_pose_ = pose;
-  last_pose_stamp_ = stamp;
   ++counters_.fused;
-  last_fused_wall_ = wallNow();
+  last_fused_wall_ = core::steadySeconds();
   fused_window_.add(last_fused_wall_);
   last_times_ = times;
   last_mean_conflict_ = stats.meanConflict();
@@ -475,7 +470,7 @@ void FusionWorker::publish(const std_msgs::Header& header)
 void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  const double now = wallNow();
+  const double now = core::steadySeconds();
   const core::StreamHealthParams& h = node_params_.health;
   const std::size_t fused = fused_window_.count(now);
   const std::size_t lost = lost_window_.count(now);

@@ -154,13 +154,11 @@ bool PriorGridNode::load()
     params.validate();
     ++loads_;
     report_ = map_io::MapLoadReport{};
-    report_.file = params.map.file;
-    map_io::MapLoadReport report;
-    const core::VectorMap map = map_io::loadVectorMap(params.map, &report);
-    report_ = report;
-    ROS_INFO_STREAM("prior_grid: " << map_io::summary(report));
-    for (std::size_t i = 0; i < std::min(kMaxLoggedSkips, report.messages.size()); ++i)
-      ROS_WARN_STREAM("prior_grid: skipped " << report.messages[i]);
+    report_.file = params.map.file;  // shown even when the load fails early
+    const core::VectorMap map = map_io::loadVectorMap(params.map, &report_);
+    ROS_INFO_STREAM("prior_grid: " << map_io::summary(report_));
+    for (std::size_t i = 0; i < std::min(kMaxLoggedSkips, report_.messages.size()); ++i)
+      ROS_WARN_STREAM("prior_grid: skipped " << report_.messages[i]);
     publish(params, map);
     loaded_ = true;
   }

@@ -1,7 +1,6 @@
 #include "map_aided_fusion/ros/scan_grid_worker.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 
 #include <boost/make_shared.hpp>
@@ -24,6 +23,12 @@ constexpr double kMinJumpThreshold = 0.001;
 constexpr double kMaxJumpThreshold = 3600.0;
 /// Wall period of the clock watch (backward /clock jumps), s.
 constexpr double kClockCheckPeriod = 0.1;
+
+/// A frame id as tf2 knows it: tf1-style "/lidar" without its leading slash.
+std::string tfFrame(const std::string& frame)
+{
+  return frame.empty() || frame[0] != '/' ? frame : frame.substr(1);
+}
 
 /// The reconfigurable fields of @p m, written into @p c (what the server then shows and replies).
 void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
@@ -104,7 +109,7 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   updater_->setHardwareID("scan_grid");
   updater_->add("ScanGrid", this, &ScanGridWorker::diagnose);
   for (auto* w : { &received_window_, &published_window_, &rejected_window_ }) w->setSpan(params_.health.diagnostic_window);
-  start_wall_ = wallNow();
+  start_wall_ = core::steadySeconds();
   clock_jump_.setThreshold(params_.time_jump_threshold);
   diagnostic_timer_ = nh_.createWallTimer(ros::WallDuration(params_.health.diagnostic_period),
                                           [this](const ros::WallTimerEvent&) { updater_->force_update(); });
@@ -138,7 +143,7 @@ void ScanGridWorker::reject(const std::string& reason, const std::string& detail
 {
   ++counters_.clouds_rejected;
   ++counters_.rejections[reason];
-  rejected_window_.add(wallNow());
+  rejected_window_.add(core::steadySeconds());
   if (reported_.insert(reason).second)
     ROS_ERROR("scan_grid: rejected a cloud on %s (%s): %s. Further clouds rejected for this reason are only "
               "counted (see diagnostics).",
@@ -154,11 +159,6 @@ bool ScanGridWorker::viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCl
   if (r == CloudRejection::kNone) return true;
   reject(toString(r), detail);
   return false;
-}
-
-double ScanGridWorker::wallNow() const
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 void ScanGridWorker::checkClock()
@@ -183,7 +183,7 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.clouds_received;
-    received_window_.add(wallNow());
+    received_window_.add(core::steadySeconds());
     core::PointCloudView view;
     if (!viewOf(*cloud, view)) return;
     if (cloud->header.frame_id.empty())
@@ -205,7 +205,7 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
       return;
     }
     const std::string& frame = cloud->header.frame_id;
-    const std::string source = frame[0] != '/' ? frame : frame.substr(1);
+    const std::string source = tfFrame(frame);
     if (!tf_buffer_->_frameExists(source))
       ROS_WARN_THROTTLE(1.0, "scan_grid: frame '%s' of %s is unknown to tf so far; the cloud waits for a transform "
                              "to %s",
@@ -238,7 +238,7 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   try
   {
     const std::string& frame = cloud->header.frame_id;
-    const std::string source = frame.empty() || frame[0] != '/' ? frame : frame.substr(1);  // tf1-style "/lidar"
+    const std::string source = tfFrame(frame);
     pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, source, cloud->header.stamp).transform);
     builder_.setSensorPose(pose);
   }
@@ -277,7 +277,7 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
     occupancy_pub_.publish(occupancy);
   }
   ++counters_.clouds_published;
-  last_published_wall_ = wallNow();
+  last_published_wall_ = core::steadySeconds();
   published_window_.add(last_published_wall_);
   const double elapsed = (ros::WallTime::now() - start).toSec();
   window_processing_sum_ += elapsed;
@@ -318,7 +318,7 @@ void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level
 void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  const double now = wallNow();
+  const double now = core::steadySeconds();
   const std::size_t published = published_window_.count(now);
   const std::size_t rejected = rejected_window_.count(now);
   const double mean_ms = window_processed_ > 0 ? kMillisecondsPerSecond * window_processing_sum_ /

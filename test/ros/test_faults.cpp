@@ -3,6 +3,7 @@
 // test/bag_loop.test runs BagLoop.* under simulated time, replaying a recorded drive three times in a loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -315,8 +316,16 @@ TEST(Faults, Item6_ReconfigureRepliesWithTheValuesInForce)
 TEST(Faults, Item7_HugeWindowIsRefusedAndTheManagerKeepsWorking)
 {
   setUpPipeline();
-  // test/faults.test loads a second FusionNodelet with a 12 GB window into the same manager.
+  // test/faults.test loads a second FusionNodelet with a 12 GB window into the same manager: its loader is up
+  // with that configuration, but the nodelet refused to start (no reconfigure service of its own).
   ros::NodeHandle nh;
+  double size_x = 0.0;
+  EXPECT_TRUE(nh.getParam("/map_aided_fusion/fusion_huge/size_x", size_x) && size_x == 4096.0)
+      << "the huge nodelet was not configured";
+  std::vector<std::string> nodes;
+  ros::master::getNodes(nodes);
+  EXPECT_NE(std::find(nodes.begin(), nodes.end(), "/map_aided_fusion/fusion_huge"), nodes.end())
+      << "the huge nodelet was not loaded";
   EXPECT_FALSE(ros::service::exists("/map_aided_fusion/fusion_huge/set_parameters", false))
       << "the huge fusion nodelet started";
   const double fused = probe->value("fusion", "scans fused");

@@ -5,12 +5,19 @@
  */
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <deque>
 #include <string>
 
 namespace map_aided_fusion {
 namespace core {
+
+/// Seconds on the monotonic clock the diagnostics windows are fed with (never jumps with ROS or wall time).
+inline double steadySeconds()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 /**
  * @brief Counts events whose time (seconds, any monotonic clock) lies in (now − span, now].
@@ -24,7 +31,6 @@ public:
   explicit SlidingCounter(double span = 5.0) : span_(span) {}
 
   void setSpan(double span) { span_ = span; }
-  double span() const { return span_; }
 
   /// Records @p n events at time @p t.
   void add(double t, std::size_t n = 1)
@@ -48,15 +54,6 @@ public:
     const double elapsed = now - start;
     const double window = elapsed < span_ ? elapsed : span_;
     return window > 0.0 ? static_cast<double>(count(now)) / window : 0.0;
-  }
-
-  /// Time of the newest event, or @p none when the window holds none.
-  double newest(double none) const { return events_.empty() ? none : events_.back().t; }
-
-  void clear()
-  {
-    events_.clear();
-    total_ = 0;
   }
 
 private:

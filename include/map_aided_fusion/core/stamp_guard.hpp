@@ -60,7 +60,6 @@ class StampGuard
 {
 public:
   explicit StampGuard(const TimeGuardParams& params = TimeGuardParams{}) : params_(params) {}
-  void setParams(const TimeGuardParams& params) { params_ = params; }
 
   /// The verdict for a scan stamped @p stamp (seconds).
   StampVerdict check(double stamp) const;

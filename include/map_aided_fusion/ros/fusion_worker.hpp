@@ -88,7 +88,6 @@ private:
   void resetForTimeJump(const std::string& why);
   /// Counts a scan that will not be fused; caller holds mutex_.
   void countLost(std::size_t& counter);
-  double wallNow() const;
   void onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason);
   void onPrior(const EvidentialGrid::ConstPtr& msg);
   void onReconfigure(FusionConfig& config, uint32_t level);
@@ -106,7 +105,6 @@ private:
   core::StampGuard stamp_guard_;
   core::ClockJumpDetector clock_jump_;
   std::optional<core::Pose2> last_pose_;
-  double last_pose_stamp_ = 0.0;
   std::string last_scan_frame_;
   FusionCounters counters_;
   core::SlidingCounter fused_window_, lost_window_;

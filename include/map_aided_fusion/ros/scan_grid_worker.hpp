@@ -84,7 +84,6 @@ private:
                           tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onReconfigure(ScanGridConfig& config, std::uint32_t level);
   void checkClock();
-  double wallNow() const;
   void reject(const std::string& reason, const std::string& detail);
   /// A view of the cloud's x, y, z; false (rejected and counted) when the cloud cannot be read. Caller holds mutex_.
   bool viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCloudView& view);
