@@ -1,5 +1,5 @@
 # Evaluation: ROS-free metrics library, the `evaluate` tool (reads bags) and its tests.
-add_library(map_aided_fusion_eval src/eval/metrics.cpp)
+add_library(map_aided_fusion_eval src/eval/metrics.cpp src/eval/point_labels.cpp)
 target_link_libraries(map_aided_fusion_eval map_aided_fusion_core)
 target_include_directories(map_aided_fusion_eval PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 
@@ -15,6 +15,7 @@ endif()
 find_package(yaml-cpp REQUIRED)
 add_executable(evaluate src/tools/evaluate.cpp)
 target_link_libraries(evaluate map_aided_fusion_eval map_aided_fusion_map_io map_aided_fusion_scan_grid_nodelet
+  map_aided_fusion_dataset_ros
   yaml-cpp ${catkin_LIBRARIES})
 add_dependencies(evaluate ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

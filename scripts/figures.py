@@ -106,8 +106,8 @@ def figure2(out):
     ax.imshow(prior_rgb, origin="lower", extent=extent(grid), interpolation="nearest")
     draw_objects(ax, meta)
     finish(ax, grid, "(b) PriorGrid: road R white, building B blue, other T grey")
-    for ax, name, title in ((axes[1, 0], "no_prior", "(c) MapGrid without prior information"),
-                            (axes[1, 1], "full", "(d) MapGrid with prior map knowledge")):
+    for ax, name, title in ((axes[1, 0], "default_no_prior", "(c) MapGrid without prior information"),
+                            (axes[1, 1], "default", "(d) MapGrid with prior map knowledge")):
         betp = np.load(snap / f"figure_{name}_betp.npy")
         decision = np.load(snap / f"figure_{name}_decision.npy")
         ax.imshow(betp_to_rgb(betp, decision), origin="lower", extent=extent(grid), interpolation="nearest")
@@ -156,7 +156,7 @@ def scores_over_time(out):
         return
     fig, axes = plt.subplots(1, 3, figsize=(14, 4), sharey=True)
     for ax, cls in zip(axes, ("moving", "stopped", "building")):
-        for variant, style in (("full", "-"), ("no_prior", "--")):
+        for variant, style in (("default", "-"), ("default_no_prior", "--")):
             pts = [(float(r["time_s"]), float(r[f"{cls}_recall"])) for r in rows
                    if r["variant"] == variant and r[f"{cls}_recall"] != ""]
             if not pts:

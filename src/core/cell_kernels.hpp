@@ -399,6 +399,17 @@ MAF_INLINE T updateCounter(T zeta, T m_occupied, T conflict, float delta_inc, fl
   return select(conflict > gamma_conflict, down, select(m_occupied >= gamma_o, up, zeta));
 }
 
+/// Step "moving expiry": where the scan holds no occupied mass, m({V}) moves to Ω (no object moves in a cell not
+/// seen occupied now).
+template <class T>
+MAF_INLINE void expireMoving(T (&m)[kSubsets], T scan_occupied)
+{
+  const T zero{};
+  const T expired = select(scan_occupied > zero, zero, m[FrameMG::kV]);
+  m[FrameMG::kV] -= expired;
+  m[FrameMG::kOmega] += expired;
+}
+
 /// Equation 4, in place; @p literal selects SpecialisationMode::kLiteral.
 template <typename T>
 MAF_INLINE void specialise(T (&m)[kSubsets], T zeta, bool literal)

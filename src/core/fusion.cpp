@@ -26,10 +26,17 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   {
     r.zeta = zeta_prev;
     r.mass = fused;
-    return r;
   }
-  r.zeta = updateCounter(zeta_prev, fused.massInside(FrameMG::kO), r.conflicts, params.counter);
-  r.mass = specialise(fused, r.zeta, params.counter.mode);
+  else
+  {
+    r.zeta = updateCounter(zeta_prev, fused.massInside(FrameMG::kO), r.conflicts, params.counter);
+    r.mass = specialise(fused, r.zeta, params.counter.mode);
+  }
+  if (params.moving_expiry && !(scan[FrameSG::kO] > 0.0))
+  {
+    r.mass[FrameMG::kOmega] += r.mass[FrameMG::kV];
+    r.mass[FrameMG::kV] = 0.0;
+  }
   return r;
 }
 
@@ -54,6 +61,7 @@ struct StepInputs
   bool contextual;
   float alpha_single;
   bool use_counter;
+  bool moving_expiry;
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
 };
 
@@ -91,6 +99,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       kernels::store(zeta + i, z);
       kernels::specialise(m, z, in.literal);
     }
+    if (in.moving_expiry) kernels::expireMoving(m, load<T>(in.so + i));
     kernels::renormalise(m);
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
@@ -145,6 +154,7 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   in.contextual = params.contextual_discounting;
   in.alpha_single = static_cast<float>(params.alpha_single);
   in.use_counter = params.use_counter;
+  in.moving_expiry = params.moving_expiry;
   for (int e = 0; e < FrameMG::kSize; ++e)
   {
     if (betp) betp->p[e].resize(in.cells);

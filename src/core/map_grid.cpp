@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "map_aided_fusion/core/parameters.hpp"
+#include "cell_kernels.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -23,6 +24,8 @@ constexpr double kMaxBudgetMb = 1048576.0;
 constexpr double kBytesPerMb = 1048576.0;
 /// m(Ω) at or above 1 − this is a vacuous cell.
 constexpr float kVacuousTolerance = 1e-3f;
+/// Largest obstacle_clearance, m.
+constexpr double kMaxObstacleClearance = 5.0;
 
 double secondsSince(std::chrono::steady_clock::time_point t0)
 {
@@ -40,6 +43,13 @@ template <class Frame>
 void copyCell(const MassGrid<Frame>& from, std::size_t i, MassGrid<Frame>& to, std::size_t j)
 {
   for (int a = 0; a < Frame::kNumSubsets; ++a) to.plane(static_cast<Subset>(a))[j] = from.plane(static_cast<Subset>(a))[i];
+}
+
+/// Cells marked occupied by one projectScan() call (thread-local scratch, reused between scans).
+std::vector<std::size_t>& projectScratch()
+{
+  thread_local std::vector<std::size_t> cells;
+  return cells;
 }
 
 }  // namespace
@@ -66,6 +76,10 @@ void MapGridParams::validate() const
                                        "resolution or raise memory_budget_mb");
   requireInRange("recentre_distance", recentre_distance, 0.0, 0.5 * std::min(size_x, size_y));
   requireUnit("decision_threshold", decision_threshold);
+  requireInRange("obstacle_clearance", obstacle_clearance, 0.0, kMaxObstacleClearance);
+  requireUnit("motion_share", motion_share);
+  requireUnit("motion_margin", motion_margin);
+  if (motion_max_cells < 1) throw ParameterError("motion_max_cells", "must be at least 1");
   if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
   fusion.validate();
 }
@@ -86,6 +100,12 @@ double MapGridParams::bytesNeeded() const
 
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)
 {
+  projectScan(scan, pose, window, out, nullptr, 0);
+}
+
+void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out,
+                 const ObstaclePoints* obstacles, int clearance_cells)
+{
   if (out.geometry() != window) out.reset(window);
   const GridGeometry& sg = scan.geometry();
   // m(∅) of a ScanGrid is not used by the fusion: only F, O and Ω are mapped (∅ stays 0 in out).
@@ -95,6 +115,7 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
   const float* const sf = scan.plane(FrameSG::kF);
   const float* const s_o = scan.plane(FrameSG::kO);
   const float* const sw = scan.plane(FrameSG::kOmega);
+  const bool points = obstacles != nullptr;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   const double inv_res = 1.0 / sg.resolution;
   const double dfx = c * window.resolution * inv_res, dfy = -s * window.resolution * inv_res;
@@ -119,8 +140,8 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
           {
             const std::size_t i = static_cast<std::size_t>(static_cast<int>(fy) * sg.width + static_cast<int>(fx));
             df[j] = sf[i];
-            d_o[j] = s_o[i];
-            dw[j] = sw[i];
+            d_o[j] = points ? 0.0f : s_o[i];
+            dw[j] = points ? sw[i] + s_o[i] : sw[i];
           }
           else
           {
@@ -129,15 +150,57 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
           }
         }
       }
-  // Forward pass: every occupied scan cell marks the window cell under its centre.
-  for (std::size_t i = 0; i < scan.numCells(); ++i)
+  std::vector<std::size_t>& occupied = projectScratch();
+  occupied.clear();
+  if (points)
   {
-    if (s_o[i] <= 0.0f) continue;
-    const Point2 v = sg.cellCentre(sg.cellOf(i));
-    CellIndex wc;
-    if (!window.worldToCell(Point2{ pose.x + c * v.x - s * v.y, pose.y + s * v.x + c * v.y }, wc)) continue;
-    const std::size_t j = window.index(wc);
-    if (s_o[i] > d_o[j]) copyCell(scan, i, out, j);
+    // Point occupancy: each return marks the window cell under it with its scan cell's occupied mass.
+    for (std::size_t k = 0; k < obstacles->count; ++k)
+    {
+      const double vx = obstacles->xy[2 * k], vy = obstacles->xy[2 * k + 1];
+      CellIndex sc, wc;
+      if (!sg.worldToCell(Point2{ vx, vy }, sc)) continue;
+      const float o = s_o[sg.index(sc)];
+      if (o <= 0.0f) continue;
+      if (!window.worldToCell(Point2{ pose.x + c * vx - s * vy, pose.y + s * vx + c * vy }, wc)) continue;
+      const std::size_t j = window.index(wc);
+      if (d_o[j] == 0.0f) occupied.push_back(j);
+      if (o > d_o[j])
+      {
+        df[j] = 0.0f;
+        d_o[j] = o;
+        dw[j] = 1.0f - o;
+      }
+    }
+  }
+  else
+  {
+    // Forward pass: every occupied scan cell marks the window cell under its centre.
+    for (std::size_t i = 0; i < scan.numCells(); ++i)
+    {
+      if (s_o[i] <= 0.0f) continue;
+      const Point2 v = sg.cellCentre(sg.cellOf(i));
+      CellIndex wc;
+      if (!window.worldToCell(Point2{ pose.x + c * v.x - s * v.y, pose.y + s * v.x + c * v.y }, wc)) continue;
+      const std::size_t j = window.index(wc);
+      if (s_o[i] > d_o[j]) copyCell(scan, i, out, j);
+    }
+  }
+  if (clearance_cells <= 0) return;
+  // Obstacle clearance: no free evidence next to an occupied cell.
+  if (!points)
+    for (std::size_t j = 0; j < window.numCells(); ++j)
+      if (d_o[j] > 0.0f) occupied.push_back(j);
+  for (const std::size_t j : occupied)
+  {
+    const int cx = static_cast<int>(j % static_cast<std::size_t>(w)), cy = static_cast<int>(j / static_cast<std::size_t>(w));
+    for (int y = std::max(0, cy - clearance_cells); y <= std::min(h - 1, cy + clearance_cells); ++y)
+      for (int x = std::max(0, cx - clearance_cells); x <= std::min(w - 1, cx + clearance_cells); ++x)
+      {
+        const std::size_t n = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        dw[n] += df[n];
+        df[n] = 0.0f;
+      }
   }
 }
 
@@ -195,6 +258,84 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
     const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
     out[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
   }
+}
+
+void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
+            std::vector<std::int8_t>& out)
+{
+  decide(grid, betp, params.decision_threshold, out);
+  if (params.motion_margin <= 0.0) return;
+  const float margin = static_cast<float>(params.motion_margin);
+  const float* ps = betp[FrameMG::kSize - 2].data();
+  const float* pv = betp[FrameMG::kSize - 1].data();
+  const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if ((out[i] == stopped || out[i] == moving) && std::abs(ps[i] - pv[i]) < margin)
+      out[i] = static_cast<std::int8_t>(CellClass::kOccupied);
+}
+
+std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
+                         int max_cells, double threshold)
+{
+  if (share <= 0.0) return 0;
+  const GridGeometry& g = grid.geometry();
+  const std::size_t n = g.numCells();
+  const float* so = scan.plane(FrameSG::kO);
+  const float* pv = betp[FrameMG::kSize - 1].data();
+  const float t = static_cast<float>(threshold);
+  thread_local std::vector<std::uint8_t> seen;
+  thread_local std::vector<std::size_t> stack, region;
+  seen.assign(n, 0);
+  std::size_t spread = 0;
+  for (std::size_t start = 0; start < n; ++start)
+  {
+    if (seen[start] || so[start] <= 0.0f) continue;
+    region.clear();
+    stack.assign(1, start);
+    seen[start] = 1;
+    std::size_t moving = 0;
+    while (!stack.empty())
+    {
+      const std::size_t i = stack.back();
+      stack.pop_back();
+      region.push_back(i);
+      moving += pv[i] >= t;
+      const CellIndex c = g.cellOf(i);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+        {
+          const CellIndex nb{ c.x + dx, c.y + dy };
+          if (!g.contains(nb)) continue;
+          const std::size_t j = g.index(nb);
+          if (!seen[j] && so[j] > 0.0f)
+          {
+            seen[j] = 1;
+            stack.push_back(j);
+          }
+        }
+    }
+    if (moving == 0 || static_cast<int>(region.size()) > max_cells ||
+        static_cast<double>(moving) < share * static_cast<double>(region.size()))
+      continue;
+    ++spread;
+    for (const std::size_t i : region)
+    {
+      float m[kernels::kSubsets];
+      for (int a = 0; a < kernels::kSubsets; ++a) m[a] = grid.plane(static_cast<Subset>(a))[i];
+      for (int a = 0; a < kernels::kSubsets; ++a)
+        if ((a & FrameMG::kV) && a != FrameMG::kV && !(a & FrameMG::kF))
+        {
+          m[FrameMG::kV] += m[a];
+          m[a] = 0.0f;
+        }
+      kernels::renormalise(m);
+      for (int a = 0; a < kernels::kSubsets; ++a) grid.plane(static_cast<Subset>(a))[i] = m[a];
+      float p[FrameMG::kSize];
+      kernels::pignistic(m, p);
+      for (int e = 0; e < FrameMG::kSize; ++e) betp.p[e][i] = p[e];
+    }
+  }
+  return spread;
 }
 
 std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<std::int8_t>& decision,
@@ -348,7 +489,7 @@ void MapGrid::recentre(Point2 p)
 }
 
 FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, double stamp, const PriorWindow* prior,
-                                StageTimes* times)
+                                StageTimes* times, const ObstaclePoints* obstacles)
 {
   StageTimes t;
   auto t0 = std::chrono::steady_clock::now();
@@ -368,7 +509,8 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   t.shift = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  projectScan(scan, pose, grid_.geometry(), scan_window_);
+  const int clearance = static_cast<int>(std::lround(params_.obstacle_clearance / params_.resolution));
+  projectScan(scan, pose, grid_.geometry(), scan_window_, params_.point_occupancy ? obstacles : nullptr, clearance);
   t.project_scan = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -380,6 +522,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   if (params_.rates_per_second && scans_ > 0) fp.discount = fp.discount.compounded(std::max(0.0, stamp - last_stamp_));
   FusionStepStats stats;
   fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_);
+  spreadMotion(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells, params_.decision_threshold);
   t.fusion = secondsSince(t0);
 
   last_stamp_ = stamp;

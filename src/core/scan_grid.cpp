@@ -90,6 +90,7 @@ void ScanGridParams::validate() const
   requireUnit("mu_occupied", mu_occupied);
   requireInRange("free_decay_length", free_decay_length, 0.0, kMaxExtent);
   requireInRange("free_margin", free_margin, 0.0, max_range);
+  requireInRange("relative_height_limit", relative_height_limit, 0.0, kMaxExtent);
   const double cells = std::round(grid_size_x / grid_resolution) * std::round(grid_size_y / grid_resolution);
   if (!(cells <= static_cast<double>(kScanGridMaxCells)))
     throw ParameterError("grid_size_x", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
@@ -224,6 +225,17 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     obstacle_range2_.resize(n_points + 1);
     obstacle_cell_.resize(n_points + 1);
   }
+  if (obstacle_points_.size() < 2 * (n_points + 1)) obstacle_points_.resize(2 * (n_points + 1));
+  const bool relative = params_.relative_height_limit > 0.0;
+  const float relative_below = static_cast<float>(params_.ground_height + params_.relative_height_limit);
+  if (relative)
+  {
+    if (obstacle_z_.size() < n_points + 1) obstacle_z_.resize(n_points + 1);
+    cell_min_z_.assign(geometry_.numCells(), kInfinity);
+  }
+  float* const obstacle_z = obstacle_z_.data();
+  float* const cell_min_z = cell_min_z_.data();
+  float* const obstacle_xy = obstacle_points_.data();
 
   const Eigen::Matrix3f rot = sensor_pose_.rotation().cast<float>();
   // Points relative to the table's sensor position (within kSensorMoveTolerance of the current one).
@@ -303,6 +315,16 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         ++self;
         continue;
       }
+      if (relative)
+      {
+        const float fx = cx0 + dx * inv_res;
+        const float fy = cy0 + dy * inv_res;
+        if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
+        {
+          float& lowest = cell_min_z[static_cast<int>(fy) * width + static_cast<int>(fx)];
+          lowest = std::min(lowest, z);
+        }
+      }
       if (z < ground_lo)
       {
         ++below_ground;
@@ -326,6 +348,9 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         obstacle_range2[n_obstacle] = r2;
         obstacle_cell[n_obstacle] =
             inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
+        obstacle_xy[2 * n_obstacle] = dx;
+        obstacle_xy[2 * n_obstacle + 1] = dy;
+        if (relative) obstacle_z[n_obstacle] = z;
         ++n_obstacle;
       }
       else
@@ -334,6 +359,40 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       }
     }
   }
+  std::size_t low_relief = 0;
+  if (relative)
+  {
+    // Relative obstacle height: keep a return only when it stands obstacle_min_height above the local lowest return.
+    const float relief = static_cast<float>(params_.obstacle_min_height);
+    const int height = geometry_.height;
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < n_obstacle; ++k)
+    {
+      const std::uint32_t cell = obstacle_cell[k];
+      if (cell != kOutside && obstacle_z[k] < relative_below)
+      {
+        const int x = static_cast<int>(cell % static_cast<std::uint32_t>(width));
+        const int y = static_cast<int>(cell / static_cast<std::uint32_t>(width));
+        float lowest = kInfinity;
+        for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
+          for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx)
+            lowest = std::min(lowest, cell_min_z[ny * width + nx]);
+        if (obstacle_z[k] - lowest < relief)
+        {
+          ++low_relief;
+          continue;
+        }
+      }
+      obstacle_sector[kept] = obstacle_sector[k];
+      obstacle_range2[kept] = obstacle_range2[k];
+      obstacle_cell[kept] = cell;
+      obstacle_xy[2 * kept] = obstacle_xy[2 * k];
+      obstacle_xy[2 * kept + 1] = obstacle_xy[2 * k + 1];
+      ++kept;
+    }
+    n_obstacle = kept;
+  }
+  st.low_relief = low_relief;
   st.non_finite = non_finite;
   st.no_return = no_return;
   st.below_min_range = below_min;
@@ -408,7 +467,20 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       m_omega[i] = 1.0f - mu_o;
       ++occupied;
     }
-  for (std::size_t k = 0; k < n_obstacle; ++k) st.obstacle_outside_grid += obstacle_cell_[k] == kOutside;
+  std::size_t kept = 0;
+  const float sensor_x = static_cast<float>(table_sensor_x_), sensor_y = static_cast<float>(table_sensor_y_);
+  for (std::size_t k = 0; k < n_obstacle; ++k)
+  {
+    if (obstacle_cell_[k] == kOutside)
+    {
+      ++st.obstacle_outside_grid;
+      continue;
+    }
+    obstacle_xy[2 * kept] = obstacle_xy[2 * k] + sensor_x;
+    obstacle_xy[2 * kept + 1] = obstacle_xy[2 * k + 1] + sensor_y;
+    ++kept;
+  }
+  obstacle_count_ = kept;
   st.occupied_cells = occupied;
   st.free_cells = free_cells;
   if (stats) *stats = st;

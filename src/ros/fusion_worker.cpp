@@ -312,6 +312,10 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
           !(scan.plane(2)[i] >= 0.0f) || !(scan.plane(3)[i] >= 0.0f))
         throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " + std::to_string(s) + ")");
     }
+    if (msg->obstacle_points.size() % 2 != 0)
+      throw ConversionError("obstacle_points holds an odd number of coordinates");
+    for (const float v : msg->obstacle_points)
+      if (!std::isfinite(v)) throw ConversionError("obstacle_points holds a non-finite coordinate");
   }
   catch (const ConversionError& e)
   {
@@ -405,7 +409,9 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     warned_no_prior_ = true;
   }
   core::StageTimes times;
-  const auto stats = grid_.update(scan, pose, stamp, prior_.get(), &times);
+  const core::ObstaclePoints obstacles{ msg->obstacle_points.data(), msg->obstacle_points.size() / 2 };
+  const auto stats =
+      grid_.update(scan, pose, stamp, prior_.get(), &times, msg->obstacle_points.empty() ? nullptr : &obstacles);
   stamp_guard_.accept(stamp);
   last_pose_ = pose;
   ++counters_.fused;
@@ -442,7 +448,7 @@ void FusionWorker::publish(const std_msgs::Header& header)
     betp_pub_[e].publish(occ);
   }
   std::vector<std::int8_t> decision;
-  core::decide(grid, betp, grid_.params().decision_threshold, decision);
+  core::decide(grid, betp, grid_.params(), decision);
   if (decision_pub_.getNumSubscribers() > 0)
   {
     auto occ = boost::make_shared<nav_msgs::OccupancyGrid>();

@@ -268,6 +268,8 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   {
     auto msg = boost::make_shared<EvidentialGrid>();
     GridConversions::toMessage(grid_, header, *msg);
+    const core::ObstaclePoints obstacles = builder_.obstaclePoints();
+    msg->obstacle_points.assign(obstacles.xy, obstacles.xy + 2 * obstacles.count);
     grid_pub_.publish(msg);
   }
   if (occupancy_pub_.getNumSubscribers() > 0)

@@ -40,6 +40,8 @@ std_msgs::ColorRGBA Visualization::classColour(CellClass c)
       return rgba(0.0f, 0.8f, 0.0f, 1.0f);
     case CellClass::kMoving:
       return rgba(1.0f, 0.0f, 0.0f, 1.0f);
+    case CellClass::kOccupied:
+      return rgba(1.0f, 0.6f, 0.0f, 1.0f);
     case CellClass::kUnknown:
       break;
   }

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -28,12 +29,15 @@
 #include "map_aided_fusion/GroundTruthObjectArray.h"
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
+#include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/eval/metrics.hpp"
+#include "map_aided_fusion/eval/point_labels.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
 #include "map_aided_fusion/map_io/yaml_params.hpp"
 #include "map_aided_fusion/ros/eval_conversions.hpp"
+#include "map_aided_fusion/ros/kitti_bag.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
 
 namespace fs = std::filesystem;
@@ -60,6 +64,7 @@ struct Options
   std::string map_frame = "map";
   double snapshot_time = -1.0;  // s after the first scan; < 0: 70 % of the run
   double sheet_period = 5.0;    // s between contact-sheet frames
+  double match_radius = 1.0;   // m: a V cell farther from every moving labelled point is a false V
   bool ablations = true;
   bool quiet = false;
 };
@@ -69,11 +74,16 @@ void usage()
   std::cerr << "usage: evaluate --bag SCENARIO.bag [--output-bag LIVE.bag] [--out DIR]\n"
                "                [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
                "                [--map FILE] [--origin LAT,LON[,ALT]] [--snapshot-time S] [--sheet-period S]\n"
-               "                [--no-ablations] [--quiet]\n"
-               "  Runs the pipeline offline on the scenario bag (topics /points, /tf, /tf_static,\n"
-               "  /ground_truth/classes, /ground_truth/objects) with the paper's method and its ablations,\n"
-               "  scores a bag recorded from the live nodelets (topic " "/map_aided_fusion/decision) when given,\n"
-               "  and writes DIR/metrics.json, DIR/metrics.md, DIR/scores.csv and DIR/snapshots/.\n";
+               "                [--match-radius M] [--no-ablations] [--quiet]\n"
+               "  Runs the pipeline offline on the bag with the configured method (variant `default`), the\n"
+               "  paper's exact method (`paper`) and their ablations, scores a bag recorded from the live\n"
+               "  nodelets (topic /map_aided_fusion/decision) when given, and writes DIR/metrics.json,\n"
+               "  DIR/metrics.md, DIR/scores.csv and DIR/snapshots/.\n"
+               "  A simulator bag (/ground_truth/classes, /ground_truth/objects) is scored per cell and per object;\n"
+               "  a labelled real bag (/ground_truth/points, from kitti_to_bag) per labelled point: false V (V cells\n"
+               "  farther than --match-radius, 1 m, from every moving point), moving objects' cells decided V,\n"
+               "  decisions of static obstacle cells. Without --map (or a map_file in the prior config) the\n"
+               "  pipeline runs without prior.\n";
 }
 
 // ---- configuration files (the nodelets' YAML files, read without a ROS master) -------------------------
@@ -154,10 +164,16 @@ struct Variant
 {
   eval::VariantScores scores;
   core::MapGrid grid;
+  core::ScanGridParams scan_params;
+  core::ScanGridBuilder builder;
+  bool builder_ready = false;
+  core::ScanMassGrid scan;
   bool use_prior;
   eval::ClassGrid decision;
-  Variant(const std::string& name, const std::string& description, const core::MapGridParams& p, bool prior)
-    : grid(p), use_prior(prior)
+  eval::PointLabelScorer points;
+  Variant(const std::string& name, const std::string& description, const core::Profile& profile, bool prior,
+          double match_radius)
+    : grid(profile.map_grid), scan_params(profile.scan_grid), use_prior(prior), points(match_radius)
   {
     scores.name = name;
     scores.description = description;
@@ -218,6 +234,7 @@ Options parse(int argc, char** argv)
     }
     else if (a == "--snapshot-time") o.snapshot_time = argDouble(a, value());
     else if (a == "--sheet-period") o.sheet_period = argDouble(a, value());
+    else if (a == "--match-radius") o.match_radius = argDouble(a, value());
     else if (a == "--no-ablations") o.ablations = false;
     else if (a == "--quiet") o.quiet = true;
     else if (a == "-h" || a == "--help")
@@ -232,12 +249,17 @@ Options parse(int argc, char** argv)
   return o;
 }
 
-core::PriorWindow loadPrior(const Options& o, const YAML::Node& prior_cfg, double resolution, std::string& summary)
+std::optional<core::PriorWindow> loadPrior(const Options& o, const YAML::Node& prior_cfg, double resolution,
+                                           std::string& summary)
 {
   map_io::PriorGridParams pp;
   map_io::forEachPriorGridParam(pp, map_io::yamlReader(prior_cfg));
   if (!o.map.empty()) pp.map.file = o.map;
-  if (pp.map.file.empty()) throw std::runtime_error("no map: give --map or map_file in the prior config");
+  if (pp.map.file.empty())
+  {
+    summary = "none (no --map and no map_file in the prior config)";
+    return std::nullopt;
+  }
   if (o.origin)
   {
     pp.map.origin_latitude = (*o.origin)[0];
@@ -253,6 +275,46 @@ core::PriorWindow loadPrior(const Options& o, const YAML::Node& prior_cfg, doubl
   summary = pp.map.file + ": " + std::to_string(vm.buildings.size()) + " buildings, " +
             std::to_string(vm.road_areas.size()) + " road surfaces";
   return window;
+}
+
+Eigen::Isometry3d toIsometry(const geometry_msgs::TransformStamped& t)
+{
+  Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
+  const auto& q = t.transform.rotation;
+  s.linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+  s.translation() = Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
+  return s;
+}
+
+/// The labelled points of one sweep in the map frame, flagged as obstacles the way the sensor model would.
+std::vector<eval::LabelledPoint> toLabelledPoints(const sensor_msgs::PointCloud2& msg, tf2::BufferCore& tf,
+                                                  const Options& o, const core::ScanGridParams& sg)
+{
+  const auto map_sensor = toIsometry(tf.lookupTransform(o.map_frame, msg.header.frame_id, msg.header.stamp));
+  const auto base_sensor = toIsometry(tf.lookupTransform(o.base_frame, msg.header.frame_id, msg.header.stamp));
+  const double lo = sg.ground_height + sg.obstacle_min_height, hi = sg.ground_height + sg.obstacle_max_height;
+  std::vector<eval::LabelledPoint> out;
+  const auto points = KittiConversions::fromLabelledCloud(msg);
+  out.reserve(points.size());
+  for (const LabelledCloudPoint& p : points)
+  {
+    const Eigen::Vector3d v(p.x, p.y, p.z);
+    const Eigen::Vector3d m = map_sensor * v;
+    const double z = (base_sensor * v).z();
+    eval::LabelledPoint lp;
+    lp.p = core::Point2{ m.x(), m.y() };
+    lp.state = static_cast<eval::LabelState>(p.state);
+    lp.obstacle = z >= lo && z <= hi && !dataset::isGroundClass(dataset::semanticClass(p.label));
+    lp.instance = lp.state == eval::LabelState::kMoving ? p.label : 0;
+    out.push_back(lp);
+  }
+  return out;
+}
+
+void writeSnapshotNpy(const fs::path& dir, const std::string& stem, const eval::ClassGrid& g)
+{
+  writeNpy(dir / (stem + "_decision.npy"), g.cells.data(),
+           { static_cast<std::size_t>(g.geometry.height), static_cast<std::size_t>(g.geometry.width) }, "|i1");
 }
 
 }  // namespace
@@ -272,13 +334,17 @@ int main(int argc, char** argv)
   }
   try
   {
+    if (!(opt.match_radius >= 0.0 && opt.match_radius <= 10.0))
+      throw std::runtime_error("--match-radius must be in [0, 10] m");
     const YAML::Node fusion_cfg = map_io::loadYamlFile(opt.fusion_config);
     const YAML::Node scan_cfg = map_io::loadYamlFile(opt.scan_grid_config);
     const YAML::Node prior_cfg = map_io::loadYamlFile(opt.prior_config);
-    const core::MapGridParams params = fusionParams(fusion_cfg);
-    const core::ScanGridParams scan_params = scanGridParams(scan_cfg);
+    core::Profile configured;
+    configured.map_grid = fusionParams(fusion_cfg);
+    configured.scan_grid = scanGridParams(scan_cfg);
     std::string prior_summary;
-    const core::PriorWindow prior = loadPrior(opt, prior_cfg, params.resolution, prior_summary);
+    const std::optional<core::PriorWindow> prior =
+        loadPrior(opt, prior_cfg, configured.map_grid.resolution, prior_summary);
 
     // Pass 1: tf, ground truth.
     rosbag::Bag bag;
@@ -286,6 +352,7 @@ int main(int argc, char** argv)
     tf2::BufferCore tf(ros::Duration(1e6));
     std::map<std::int64_t, eval::ClassGrid> truth;
     std::map<std::int64_t, std::vector<eval::TruthObject>> truth_objects;
+    std::set<std::int64_t> labelled_stamps;
     std::size_t clouds = 0;
     {
       rosbag::View view(bag);
@@ -306,6 +373,10 @@ int main(int argc, char** argv)
           if (auto msg = m.instantiate<GroundTruthObjectArray>())
             truth_objects[key(msg->header.stamp)] = toTruthObjects(*msg);
         }
+        else if (topic == "/ground_truth/points")
+        {
+          if (auto msg = m.instantiate<sensor_msgs::PointCloud2>()) labelled_stamps.insert(key(msg->header.stamp));
+        }
         else if (topic == "/points")
         {
           ++clouds;
@@ -313,43 +384,70 @@ int main(int argc, char** argv)
       }
     }
     if (clouds == 0) throw std::runtime_error(opt.bag + " has no /points");
-    if (truth.empty()) throw std::runtime_error(opt.bag + " has no /ground_truth/classes");
+    const bool point_mode = truth.empty();
+    if (point_mode && labelled_stamps.empty())
+      throw std::runtime_error(opt.bag + " has neither /ground_truth/classes (simulator) nor /ground_truth/points "
+                                         "(labelled real data, kitti_to_bag)");
 
     std::vector<std::unique_ptr<Variant>> variants;
-    // A variant: the configured method with one change.
-    auto add = [&](const std::string& name, const std::string& description, bool prior, auto&& change) {
-      core::MapGridParams p = params;
-      change(p.fusion);
-      variants.push_back(std::make_unique<Variant>(name, description, p, prior));
+    auto add = [&](const std::string& name, const std::string& description, const core::Profile& profile, bool use_prior) {
+      if (use_prior && !prior) return;
+      variants.push_back(std::make_unique<Variant>(name, description, profile, use_prior, opt.match_radius));
     };
-    auto same = [](core::FusionParams&) {};
-    add("full", "the paper's method: prior, contextual discounting, modified Yager rule, counter and specialisation",
-        true, same);
-    add("no_prior", "as full, with a vacuous PriorGrid", false, same);
+    const core::Profile paper = core::paperProfile();
+    const bool have_prior = prior.has_value();
+    add("default", "the configured method (config/*.yaml: the paper's pipeline and the steps this package adds)",
+        configured, have_prior);
+    add("paper", "the paper's exact method (config/paper/*.yaml: prior, contextual discounting, modified Yager rule, "
+                 "counter and specialisation)",
+        paper, have_prior);
+    if (have_prior)
+    {
+      add("default_no_prior", "as default, with a vacuous PriorGrid", configured, false);
+      add("paper_no_prior", "as paper, with a vacuous PriorGrid", paper, false);
+    }
     if (opt.ablations)
     {
-      add("dempster", "Dempster's rule instead of the modified Yager rule", true,
-          [](core::FusionParams& f) { f.rule = core::CombinationRule::kDempster; });
-      add("yager", "Yager's rule (all conflict to Omega) instead of the modified Yager rule", true,
-          [](core::FusionParams& f) { f.rule = core::CombinationRule::kYager; });
-      add("single_rate", "classical discounting with one rate (alpha_free) instead of contextual discounting", true,
-          [](core::FusionParams& f) {
+      auto paperWith = [&](auto&& change) {
+        core::Profile p = paper;
+        change(p.map_grid.fusion);
+        return p;
+      };
+      add("dempster", "paper, with Dempster's rule instead of the modified Yager rule",
+          paperWith([](core::FusionParams& f) { f.rule = core::CombinationRule::kDempster; }), have_prior);
+      add("yager", "paper, with Yager's rule (all conflict to Omega) instead of the modified Yager rule",
+          paperWith([](core::FusionParams& f) { f.rule = core::CombinationRule::kYager; }), have_prior);
+      add("single_rate", "paper, with classical discounting at one rate (alpha_free) instead of contextual discounting",
+          paperWith([](core::FusionParams& f) {
             f.contextual_discounting = false;
             f.alpha_single = f.discount.alpha_free;
-          });
-      add("no_counter", "no counter zeta and no specialisation", true, [](core::FusionParams& f) { f.use_counter = false; });
+          }),
+          have_prior);
+      add("no_counter", "paper, without the counter zeta and the specialisation",
+          paperWith([](core::FusionParams& f) { f.use_counter = false; }), have_prior);
+      for (const core::AddedStep& step : core::addedSteps())
+      {
+        core::Profile p = configured;
+        if (!step.enabled(p)) continue;
+        step.disable(p);
+        add("default_without_" + std::string(step.name), "default, without the step " + std::string(step.name) +
+                                                             ": " + std::string(step.summary),
+            p, have_prior);
+      }
     }
 
     fs::create_directories(fs::path(opt.out) / "snapshots");
     std::ofstream csv(fs::path(opt.out) / "scores.csv");
-    csv << "time_s,variant,scan_compared_cells";
-    for (const auto& n : core::kCellClassLongNames) csv << "," << n << "_recall";
-    csv << ",accuracy\n";
+    if (point_mode)
+      csv << "time_s,variant,labelled,v_cells,false_v,v_on_static,mover_cells,mover_v_cells\n";
+    else
+    {
+      csv << "time_s,variant,scan_compared_cells";
+      for (const auto& n : core::kCellClassLongNames) csv << "," << n << "_recall";
+      csv << ",accuracy\n";
+    }
 
-    // Pass 2: scans.
-    core::ScanGridBuilder builder;
-    bool builder_ready = false;
-    core::ScanMassGrid scan;
+    // Pass 2: scans (and, for labelled real data, the sweep's labelled points).
     std::optional<double> t0;
     std::size_t done = 0, no_truth = 0, no_pose = 0;
     double snapshot_at = -1.0, next_sheet = 0.0;
@@ -359,52 +457,96 @@ int main(int argc, char** argv)
       return (v.getEndTime() - v.getBeginTime()).toSec();
     }();
     const double snapshot_time = opt.snapshot_time >= 0.0 ? opt.snapshot_time : 0.7 * duration_guess;
-    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{ "/points" }));
+    // Labelled sweeps: the decisions wait for the sweep's points (or the points for the decisions).
+    std::map<std::int64_t, std::vector<eval::ClassGrid>> pending_decisions;
+    std::map<std::int64_t, std::vector<eval::LabelledPoint>> pending_points;
+    auto scorePending = [&](std::int64_t k) {
+      auto d = pending_decisions.find(k);
+      auto p = pending_points.find(k);
+      if (d == pending_decisions.end() || p == pending_points.end()) return;
+      const double t = static_cast<double>(k) * 1e-9;
+      for (std::size_t v = 0; v < variants.size(); ++v)
+      {
+        variants[v]->points.add(t, d->second[v], p->second, true);
+        const auto& s = variants[v]->points.sweeps().back();
+        csv << (t - *t0) << "," << variants[v]->scores.name << ",1," << s.v_cells << "," << s.false_v << ","
+            << s.v_on_static << "," << s.mover_cells << "," << s.mover_v_cells << "\n";
+      }
+      pending_decisions.erase(d);
+      pending_points.erase(p);
+    };
+    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{ "/points", "/ground_truth/points" }));
     for (const rosbag::MessageInstance& m : view)
     {
       auto cloud = m.instantiate<sensor_msgs::PointCloud2>();
-      progress(opt.quiet, ++done, clouds, "scans");
       if (!cloud) continue;
+      if (m.getTopic() == "/ground_truth/points")
+      {
+        if (!point_mode) continue;
+        try
+        {
+          pending_points[key(cloud->header.stamp)] = toLabelledPoints(*cloud, tf, opt, configured.scan_grid);
+        }
+        catch (const tf2::TransformException&)
+        {
+          continue;
+        }
+        if (t0) scorePending(key(cloud->header.stamp));
+        continue;
+      }
+      progress(opt.quiet, ++done, clouds, "scans");
       geometry_msgs::TransformStamped base, sensor;
       try
       {
         base = tf.lookupTransform(opt.map_frame, opt.base_frame, cloud->header.stamp);
-        sensor = tf.lookupTransform(opt.base_frame, cloud->header.frame_id, ros::Time(0));
+        sensor = tf.lookupTransform(opt.base_frame, cloud->header.frame_id, cloud->header.stamp);
       }
       catch (const tf2::TransformException&)
       {
         ++no_pose;
         continue;
       }
-      if (!builder_ready)
-      {
-        Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
-        const auto& q = sensor.transform.rotation;
-        s.linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
-        s.translation() =
-            Eigen::Vector3d(sensor.transform.translation.x, sensor.transform.translation.y, sensor.transform.translation.z);
-        builder.configure(scan_params, s);
-        builder_ready = true;
-      }
       core::PointCloudView pv;
       std::string detail;
       if (makePointCloudView(*cloud, pv, &detail) != CloudRejection::kNone)
         throw std::runtime_error("unreadable cloud in " + opt.bag + ": " + detail);
-      builder.build(pv, scan);
       const double t = cloud->header.stamp.toSec();
       if (!t0) t0 = t;
       const core::Pose2 pose{ base.transform.translation.x, base.transform.translation.y,
                               tf2::getYaw(base.transform.rotation) };
-      const eval::ClassGrid* gt = nearest(truth, cloud->header.stamp);
-      const auto* objects = nearest(truth_objects, cloud->header.stamp);
-      if (!gt) ++no_truth;
+      const eval::ClassGrid* gt = point_mode ? nullptr : nearest(truth, cloud->header.stamp);
+      const auto* objects = point_mode ? nullptr : nearest(truth_objects, cloud->header.stamp);
+      if (!gt && !point_mode) ++no_truth;
       const bool snapshot = snapshot_at < 0.0 && t - *t0 >= snapshot_time;
       const bool sheet = t - *t0 >= next_sheet;
+      const std::int64_t k = key(cloud->header.stamp);
+      const bool labelled = point_mode && labelled_stamps.count(k);
       for (auto& v : variants)
       {
-        v->grid.update(scan, pose, t, v->use_prior ? &prior : nullptr);
+        if (!v->builder_ready)
+        {
+          v->builder.configure(v->scan_params, toIsometry(sensor));
+          v->builder_ready = true;
+        }
+        else
+          v->builder.setSensorPose(toIsometry(sensor));
+        v->builder.build(pv, v->scan);
+        const core::ObstaclePoints obstacles = v->builder.obstaclePoints();
+        v->grid.update(v->scan, pose, t, v->use_prior ? &*prior : nullptr, nullptr, &obstacles);
         v->decision.geometry = v->grid.geometry();
-        core::decide(v->grid.masses(), v->grid.pignistic(), v->grid.params().decision_threshold, v->decision.cells);
+        core::decide(v->grid.masses(), v->grid.pignistic(), v->grid.params(), v->decision.cells);
+        if (point_mode)
+        {
+          if (labelled)
+            pending_decisions[k].push_back(v->decision);
+          else
+          {
+            v->points.add(t, v->decision, {}, false);
+            csv << (t - *t0) << "," << v->scores.name << ",0," << v->points.sweeps().back().v_cells << ",,,,\n";
+          }
+          ++v->scores.scans;
+          continue;
+        }
         if (!gt) continue;
         eval::ConfusionMatrix scan_confusion;
         const auto compared = eval::accumulate(*gt, v->decision, scan_confusion);
@@ -416,14 +558,28 @@ int main(int argc, char** argv)
           csv << "," << (scan_confusion.support(c) ? std::to_string(scan_confusion.recall(c)) : "");
         csv << "," << scan_confusion.accuracy() << "\n";
       }
+      if (labelled) scorePending(k);
+      if (point_mode)
+      {
+        // Snapshots of every sweep's decisions for the figures (small runs; long sequences: every sheet period).
+        if (sheet)
+        {
+          const fs::path dir = fs::path(opt.out) / "snapshots";
+          const std::string stem = "sweep_" + std::to_string(sheet_frame++);
+          for (const auto& v : variants) writeSnapshotNpy(dir, stem + "_" + v->scores.name, v->decision);
+          std::ofstream meta(dir / (stem + ".json"));
+          const auto& g = variants[0]->grid.geometry();
+          meta << "{\"time_s\": " << (t - *t0) << ", \"ego\": {\"x\": " << pose.x << ", \"y\": " << pose.y
+               << ", \"yaw\": " << pose.yaw << "}, \"grid\": {\"resolution\": " << g.resolution << ", \"width\": "
+               << g.width << ", \"height\": " << g.height << ", \"origin_x\": " << g.origin_x
+               << ", \"origin_y\": " << g.origin_y << "}}\n";
+          next_sheet += opt.sheet_period;
+        }
+        continue;
+      }
       if ((snapshot || sheet) && gt)
       {
         const fs::path dir = fs::path(opt.out) / "snapshots";
-        auto dumpDecision = [&](const Variant& v, const std::string& name) {
-          const auto& g = v.grid.geometry();
-          writeNpy(dir / (name + "_decision.npy"), v.decision.cells.data(),
-                   { static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "|i1");
-        };
         auto geometryJson = [](const core::GridGeometry& g) {
           std::ostringstream s;
           s << "{\"resolution\": " << g.resolution << ", \"width\": " << g.width << ", \"height\": " << g.height
@@ -431,7 +587,7 @@ int main(int argc, char** argv)
           return s.str();
         };
         const std::string stem = snapshot ? "figure" : "sheet_" + std::to_string(sheet_frame);
-        dumpDecision(*variants[0], stem + "_with_prior");
+        writeSnapshotNpy(dir, stem + "_with_prior", variants[0]->decision);
         writeNpy(dir / (stem + "_truth.npy"), gt->cells.data(),
                  { static_cast<std::size_t>(gt->geometry.height), static_cast<std::size_t>(gt->geometry.width) }, "|i1");
         std::ofstream meta(dir / (stem + ".json"));
@@ -439,10 +595,10 @@ int main(int argc, char** argv)
              << ", \"yaw\": " << pose.yaw << "}, \"grid\": " << geometryJson(variants[0]->grid.geometry())
              << ", \"truth_grid\": " << geometryJson(gt->geometry) << ", \"objects\": [";
         if (objects)
-          for (std::size_t k = 0; k < objects->size(); ++k)
+          for (std::size_t j = 0; j < objects->size(); ++j)
           {
-            const auto& o = (*objects)[k];
-            meta << (k ? ", " : "") << "{\"id\": " << o.id << ", \"class\": " << static_cast<int>(o.cell_class)
+            const auto& o = (*objects)[j];
+            meta << (j ? ", " : "") << "{\"id\": " << o.id << ", \"class\": " << static_cast<int>(o.cell_class)
                  << ", \"kind\": \"" << o.kind << "\", \"x\": " << o.centre.x << ", \"y\": " << o.centre.y
                  << ", \"yaw\": " << o.yaw << ", \"length\": " << o.length << ", \"width\": " << o.width
                  << ", \"speed\": " << o.speed << "}";
@@ -453,24 +609,27 @@ int main(int argc, char** argv)
           snapshot_at = t - *t0;
           for (const auto& v : variants)
           {
-            if (v->scores.name != "full" && v->scores.name != "no_prior") continue;
+            if (v->scores.name != "default" && v->scores.name != "default_no_prior" && v->scores.name != "paper")
+              continue;
             const auto& g = v->grid.geometry();
             std::vector<float> planes;
             for (int e = 0; e < core::FrameMG::kSize; ++e)
               planes.insert(planes.end(), v->grid.pignistic()[e].begin(), v->grid.pignistic()[e].end());
             writeNpy(dir / ("figure_" + v->scores.name + "_betp.npy"), planes.data(),
                      { 5, static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "<f4");
-            dumpDecision(*v, "figure_" + v->scores.name);
+            writeSnapshotNpy(dir, "figure_" + v->scores.name, v->decision);
           }
-          // The prior over the MapGrid window.
-          const auto& g = variants[0]->grid.geometry();
-          core::PriorWindow w;
-          core::extractPriorWindow(prior, g, w);
-          std::vector<std::int8_t> labels(g.numCells());
-          for (std::size_t i = 0; i < labels.size(); ++i)
-            labels[i] = w.building[i] > 0.0f ? 1 : w.road[i] > 0.0f ? 2 : w.other[i] > 0.0f ? 3 : 0;
-          writeNpy(dir / "figure_prior.npy", labels.data(),
-                   { static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "|i1");
+          if (prior)
+          {
+            const auto& g = variants[0]->grid.geometry();
+            core::PriorWindow w;
+            core::extractPriorWindow(*prior, g, w);
+            std::vector<std::int8_t> labels(g.numCells());
+            for (std::size_t i = 0; i < labels.size(); ++i)
+              labels[i] = w.building[i] > 0.0f ? 1 : w.road[i] > 0.0f ? 2 : w.other[i] > 0.0f ? 3 : 0;
+            writeNpy(dir / "figure_prior.npy", labels.data(),
+                     { static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "|i1");
+          }
         }
         if (sheet)
         {
@@ -479,12 +638,12 @@ int main(int argc, char** argv)
         }
       }
     }
-    bag.close();
 
     std::vector<eval::VariantScores> scores;
     for (const auto& v : variants) scores.push_back(v->scores);
 
     // The live nodelets' decisions, when recorded.
+    eval::PointLabelScorer live_points(opt.match_radius);
     if (!opt.output_bag.empty())
     {
       rosbag::Bag live;
@@ -501,29 +660,88 @@ int main(int argc, char** argv)
         progress(opt.quiet, ++k, total, "live");
         auto d = m.instantiate<nav_msgs::OccupancyGrid>();
         if (!d) continue;
+        const eval::ClassGrid decision = toClassGrid(*d);
+        if (point_mode)
+        {
+          std::vector<eval::LabelledPoint> points;
+          const bool labelled = labelled_stamps.count(key(d->header.stamp)) > 0;
+          if (labelled)
+          {
+            rosbag::View pv(bag, rosbag::TopicQuery(std::vector<std::string>{ "/ground_truth/points" }),
+                            d->header.stamp, d->header.stamp);
+            for (const rosbag::MessageInstance& pm : pv)
+              if (auto c = pm.instantiate<sensor_msgs::PointCloud2>())
+                if (c->header.stamp == d->header.stamp) points = toLabelledPoints(*c, tf, opt, configured.scan_grid);
+          }
+          live_points.add(d->header.stamp.toSec(), decision, points, labelled);
+          ++s.scans;
+          continue;
+        }
         const eval::ClassGrid* gt = nearest(truth, d->header.stamp);
         if (!gt) continue;
-        const eval::ClassGrid decision = toClassGrid(*d);
         eval::accumulate(*gt, decision, s.confusion);
         const auto* objects = nearest(truth_objects, d->header.stamp);
         s.objects.add(d->header.stamp.toSec(), *gt, objects ? *objects : std::vector<eval::TruthObject>{}, decision);
         ++s.scans;
       }
-      if (s.scans == 0) std::cerr << "evaluate: no decision of " << opt.output_bag << " matches the ground truth\n";
+      if (s.scans == 0) std::cerr << "evaluate: no decision of " << opt.output_bag << " matches the bag's stamps\n";
       scores.push_back(s);
     }
+    bag.close();
 
-    std::map<std::string, std::string> meta{ { "scenario_bag", opt.bag },
+    std::map<std::string, std::string> meta{ { "bag", opt.bag },
+                                             { "ground_truth", point_mode ? "labelled points" : "simulator cells" },
                                              { "prior", prior_summary },
                                              { "scans", std::to_string(done) },
                                              { "scans_without_pose", std::to_string(no_pose) },
                                              { "scans_without_ground_truth", std::to_string(no_truth) },
+                                             { "labelled_scans", std::to_string(labelled_stamps.size()) },
                                              { "figure_time_s", std::to_string(snapshot_at) } };
-    std::ofstream(fs::path(opt.out) / "metrics.json") << eval::toJson(scores, meta);
-    std::ofstream(fs::path(opt.out) / "metrics.md") << "# map_aided_fusion evaluation\n\nScenario: `" << opt.bag
-                                                     << "`, " << done << " scans.\n\n"
-                                                     << eval::toMarkdown(scores);
-    std::cout << eval::toMarkdown(scores);
+    std::string markdown;
+    if (point_mode)
+    {
+      std::vector<std::pair<std::string, const eval::PointLabelScorer*>> rows;
+      for (const auto& v : variants) rows.emplace_back(v->scores.name, &v->points);
+      if (!opt.output_bag.empty()) rows.emplace_back("live", &live_points);
+      markdown = eval::pointLabelMarkdown(rows);
+      std::ofstream json(fs::path(opt.out) / "metrics.json");
+      json << "{\n  \"meta\": {";
+      bool first = true;
+      for (const auto& [k, v] : meta)
+      {
+        json << (first ? "" : ", ") << "\"" << k << "\": \"" << v << "\"";
+        first = false;
+      }
+      json << "},\n  \"match_radius_m\": " << opt.match_radius << ",\n  \"variants\": {";
+      for (std::size_t r = 0; r < rows.size(); ++r)
+      {
+        json << (r ? "," : "") << "\n    \"" << rows[r].first << "\": {";
+        bool f = true;
+        for (const auto& [k, x] : rows[r].second->summary())
+        {
+          json << (f ? "" : ", ") << "\"" << k << "\": " << (std::isfinite(x) ? x : 0.0);
+          f = false;
+        }
+        json << ", \"per_sweep\": [";
+        const auto& sw = rows[r].second->sweeps();
+        for (std::size_t j = 0; j < sw.size(); ++j)
+          json << (j ? ", " : "") << "{\"labelled\": " << (sw[j].labelled ? "true" : "false")
+               << ", \"v_cells\": " << sw[j].v_cells << ", \"false_v\": " << sw[j].false_v
+               << ", \"mover_cells\": " << sw[j].mover_cells << ", \"mover_v_cells\": " << sw[j].mover_v_cells << "}";
+        json << "]}";
+      }
+      json << "\n  }\n}\n";
+    }
+    else
+    {
+      std::ofstream(fs::path(opt.out) / "metrics.json") << eval::toJson(scores, meta);
+      markdown = eval::toMarkdown(scores);
+    }
+    std::ofstream(fs::path(opt.out) / "metrics.md") << "# map_aided_fusion evaluation\n\nBag: `" << opt.bag << "`, "
+                                                     << done << " scans"
+                                                     << (point_mode ? " (labelled real data)" : "") << ".\n\n"
+                                                     << markdown;
+    std::cout << markdown;
     std::cout << "wrote " << (fs::path(opt.out) / "metrics.json").string() << ", metrics.md, scores.csv, snapshots/\n";
     return 0;
   }

@@ -210,6 +210,7 @@ TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
       const auto scan = randomScanGrid(rng, g);
       const auto prior = randomPrior(rng, g, beta);
       FusionParams params;
+      params.moving_expiry = false;  // the paper's sequence of grid ops; the step is tested in test_motion_steps
       params.counter.mode = mode;
       params.counter.gamma_conflict = 0.3;
       params.counter.gamma_occupied = 0.4;

@@ -38,6 +38,7 @@ ScanGridParams testParams()
   p.obstacle_max_height = 2.5;
   p.mu_free = 0.7;
   p.mu_occupied = 0.8;
+  p.relative_height_limit = 0.0;  // the paper's sensor model; the step has its own tests
   return p;
 }
 

@@ -41,6 +41,12 @@ struct FusionParams
   double alpha_single = 0.1;  ///< rate of the classical discounting, in [0, 1]
   /// false: no counter and no specialisation (ζ stays 0)
   bool use_counter = true;
+  /**
+   * Step "moving expiry" (not in the paper): after the step, where the scan holds no occupied mass, m({V}) moves to
+   * Ω. A moving object is where the sensor sees it now; without this, V left behind a mover (in the cells it
+   * vacated, often hidden behind it) or by a one-sweep flicker decays only by discounting, a trail of V.
+   */
+  bool moving_expiry = true;
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const
   {

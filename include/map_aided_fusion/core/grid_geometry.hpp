@@ -106,5 +106,12 @@ struct GridGeometry
   void validate() const;
 };
 
+/// A borrowed list of 2D points, interleaved x0, y0, x1, y1, … metres (count points).
+struct ObstaclePoints
+{
+  const float* xy = nullptr;
+  std::size_t count = 0;
+};
+
 }  // namespace core
 }  // namespace map_aided_fusion

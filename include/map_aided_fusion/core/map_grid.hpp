@@ -50,6 +50,38 @@ struct MapGridParams
    * decision) is refused by validate(), before anything is allocated.
    */
   double memory_budget_mb = 2048.0;
+
+  /**
+   * Step "point occupancy" (not in the paper): when the scan comes with its obstacle returns, occupied evidence
+   * goes to the window cell under each return, not to the window cells the resampled scan cell covers. A scan cell
+   * in the vehicle lattice straddles up to four window cells; resampling it moves an obstacle's edge by a cell
+   * from one sweep to the next as the vehicle moves, and ⊛ reads that free → occupied flicker as motion.
+   */
+  bool point_occupancy = true;
+  /**
+   * Step "obstacle clearance" (not in the paper): window cells within this distance of a cell holding an obstacle
+   * return (square neighbourhood of round(distance / resolution) cells) get no free evidence from this scan, m
+   * in [0, 5]; 0 disables it. At range an azimuth sector is narrower than a cell and a return's footprint wider, so
+   * a cell at an obstacle's edge is seen free in one sweep and occupied in the next.
+   */
+  double obstacle_clearance = 1.0;
+  /**
+   * Step "motion spreading" (not in the paper): after the step, each connected region (8-connectivity) of cells
+   * the scan sees occupied, of at most motion_max_cells cells, in which at least this share of cells has
+   * BetP(V) ≥ decision_threshold, is one moving object: in each of its cells the occupied mass that still leaves
+   * the motion open (focal sets holding V and other classes) goes to {V}. Conflict only marks the cells an object
+   * enters; the rest of a mover (the cells it still covers, and all of it when it moves away from the sensor) would
+   * otherwise stay undecided. In [0, 1]; 0 disables it.
+   */
+  double motion_share = 0.2;
+  int motion_max_cells = 200;  ///< largest region motion spreading treats as one object, cells (≥ 1)
+  /**
+   * Step "motion margin" (not in the paper): a cell whose decision would be S or V with |BetP(S) − BetP(V)| below
+   * this is decided CellClass::kOccupied, "occupied, motion not yet known". An object first seen already in place
+   * (no earlier free evidence) has its mass on {S, V}; the counter grows at once and specialisation would tip it to S
+   * by a hair. In [0, 1]; 0 disables it.
+   */
+  double motion_margin = 0.1;
   /// Bytes one window cell needs in the MapGrid and its per-scan buffers.
   static std::size_t bytesPerCell();
   /// Bytes the window of these parameters needs (cells × bytesPerCell()).
@@ -80,9 +112,15 @@ void forEachParam(MapGridParams& p, Get&& get)
   bool literal = p.fusion.counter.mode == SpecialisationMode::kLiteral;
   get("specialise_literal", literal);
   p.fusion.counter.mode = literal ? SpecialisationMode::kLiteral : SpecialisationMode::kMovingToStopped;
+  get("moving_expiry", p.fusion.moving_expiry);
   get("decision_threshold", p.decision_threshold);
   get("min_object_cells", p.min_object_cells);
   get("memory_budget_mb", p.memory_budget_mb);
+  get("point_occupancy", p.point_occupancy);
+  get("motion_share", p.motion_share);
+  get("motion_max_cells", p.motion_max_cells);
+  get("motion_margin", p.motion_margin);
+  get("obstacle_clearance", p.obstacle_clearance);
 }
 
 /// Wall time of each stage of MapGrid::update(), seconds.
@@ -119,6 +157,16 @@ void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const Gr
                  ScanMassGrid& out);
 
 /**
+ * @brief projectScan() with the steps "point occupancy" and "obstacle clearance".
+ * @param obstacles  when not null: the scan's obstacle returns in the vehicle frame. Occupied scan cells then map to
+ *                   Ω, and each return puts its scan cell's occupied mass in the window cell under it (exact).
+ * @param clearance_cells  window cells within this many cells (square neighbourhood) of a cell with occupied mass
+ *                   lose their free mass to Ω; 0: none.
+ */
+void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const GridGeometry& window, ScanMassGrid& out,
+                 const ObstaclePoints* obstacles, int clearance_cells);
+
+/**
  * @brief The prior masses of @p window, sampled at each window cell's centre from @p prior (nearest
  *        neighbour; an exact copy when the lattices are aligned). Cells outside @p prior are vacuous.
  */
@@ -129,6 +177,18 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
  *        where the cell is vacuous (m(Ω) ≥ 1 − 1e-3).
  */
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out);
+
+/**
+ * @brief The step "motion spreading" on @p grid and its BetP @p betp (both updated in place): see
+ *        MapGridParams::motion_share. @p scan is the scan in the grid's cells. Returns the number of regions spread.
+ */
+std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
+                         int max_cells, double threshold);
+
+/// Decision per cell with every decision parameter of @p params: the threshold, then the step "motion margin"
+/// (S or V decisions within motion_margin of each other become CellClass::kOccupied).
+void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
+            std::vector<std::int8_t>& out);
 
 /// Connected regions (8-connectivity) of kMoving or kStopped decisions with at least @p min_cells cells.
 std::vector<GridObject> extractObjects(const GridGeometry& geometry, const std::vector<std::int8_t>& decision,
@@ -161,9 +221,11 @@ public:
    * @param pose   vehicle pose in the map frame at the scan's time
    * @param stamp  scan time, seconds (used for rates_per_second)
    * @param prior  the whole PriorGrid in the map frame, or nullptr for a vacuous prior
+   * @param obstacles  the scan's obstacle returns in the vehicle frame (ScanGridBuilder::obstaclePoints()), used by
+   *               the step point_occupancy; nullptr: occupied evidence from the resampled scan cells (the paper)
    */
   FusionStepStats update(const ScanMassGrid& scan, const Pose2& pose, double stamp, const PriorWindow* prior,
-                         StageTimes* times = nullptr);
+                         StageTimes* times = nullptr, const ObstaclePoints* obstacles = nullptr);
 
   /**
    * @brief Moves the window by whole cells: the cell at (x, y) moves to (x − dx, y − dy) and the origin by

@@ -79,6 +79,16 @@ struct ScanGridParams
    * its boundary cells, which the fusion reads as a moving object.
    */
   double free_margin = 0.0;
+  /**
+   * Step "relative obstacle height" (not in the paper), m above ground_height, in [0, 10000]; 0 disables it. A
+   * return in the obstacle band but lower than this is an obstacle only when it also stands obstacle_min_height
+   * above the lowest return of its own and the 8 neighbouring cells; otherwise it is neither ground nor obstacle
+   * (counted as low_relief). On a street that is not flat (slope, camber, a raised pavement) ground returns 30–50 cm
+   * above the vehicle's ground plane otherwise become obstacles that come and go from sweep to sweep, which the
+   * fusion reads as motion. Returns higher than this are obstacles as before (a car roof seen from above has no lower
+   * return around it).
+   */
+  double relative_height_limit = 0.8;
 
   /// The grid described by the grid_* parameters.
   GridGeometry geometry() const
@@ -117,6 +127,7 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("mu_occupied", p.mu_occupied);
   get("free_decay_length", p.free_decay_length);
   get("free_margin", p.free_margin);
+  get("relative_height_limit", p.relative_height_limit);
 }
 
 /// Largest grid the builder accepts (cells), to refuse absurd sizes before allocating.
@@ -163,6 +174,7 @@ struct ScanGridStats
   std::size_t below_ground = 0;         ///< below the ground band (neither)
   std::size_t height_gap = 0;           ///< between the ground band and the obstacle band (neither)
   std::size_t above_clearance = 0;      ///< above obstacle_max_height (neither)
+  std::size_t low_relief = 0;           ///< in the obstacle band but too close to the local lowest return (neither)
   std::size_t occupied_cells = 0;       ///< cells with m(O) = μ_O
   std::size_t free_cells = 0;           ///< cells with m(F) > 0
 
@@ -199,6 +211,12 @@ public:
    *         not consistent().
    */
   bool build(const PointCloudView& points, ScanMassGrid& grid, ScanGridStats* stats = nullptr);
+
+  /**
+   * @brief The obstacle returns of the last build() that fall inside the grid, in the grid's frame (base_link):
+   *        x0, y0, x1, y1, … metres. What the `point_occupancy` step of the MapGrid places in its own cells.
+   */
+  ObstaclePoints obstaclePoints() const { return ObstaclePoints{ obstacle_points_.data(), obstacle_count_ }; }
 
   bool configured() const { return configured_; }
   const ScanGridParams& params() const { return params_; }
@@ -244,6 +262,10 @@ private:
   std::vector<std::uint32_t> obstacle_sector_;
   std::vector<float> obstacle_range2_;
   std::vector<std::uint32_t> obstacle_cell_;
+  std::vector<float> obstacle_points_;
+  std::size_t obstacle_count_ = 0;
+  std::vector<float> obstacle_z_;
+  std::vector<float> cell_min_z_;
 };
 
 }  // namespace core

@@ -1,0 +1,51 @@
+/**
+ * @file profiles.hpp
+ * @brief Named parameter sets of the whole pipeline: the paper's exact method and this package's default.
+ *
+ * The `paper` profile is the method of Kurdej et al. bit for bit (every step this package adds is off); it is
+ * what the files of `config/paper/` holds and what `evaluate` runs as the `paper` variant. The `default` profile is
+ * the parameter structs' defaults, what the files of `config/` hold. Tests check both files against these functions.
+ */
+#pragma once
+
+#include <vector>
+
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/scan_grid.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+/// The parameters of the ScanGrid and of the MapGrid (the PriorGrid is the same in both profiles).
+struct Profile
+{
+  ScanGridParams scan_grid;
+  MapGridParams map_grid;
+};
+
+/**
+ * @brief A step this package adds to the paper's pipeline: a name (its section in the README), what it does,
+ *        and how to tell and switch it in a profile. Each is off in the paper profile.
+ */
+struct AddedStep
+{
+  const char* name;
+  const char* summary;
+  bool (*enabled)(const Profile&);
+  void (*disable)(Profile&);
+};
+
+/// Every added step, in pipeline order.
+const std::vector<AddedStep>& addedSteps();
+
+/// The paper's method: every added step off, the paper's α, β, δ, γ, μ.
+Profile paperProfile();
+
+/// This package's default (the structs' defaults, the files of config/).
+inline Profile defaultProfile() { return Profile{}; }
+
+/// @p p with every step this package adds to the paper switched off (the rest unchanged).
+Profile withoutAddedSteps(Profile p);
+
+}  // namespace core
+}  // namespace map_aided_fusion

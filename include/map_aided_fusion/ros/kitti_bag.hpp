@@ -1,0 +1,79 @@
+/**
+ * @file kitti_bag.hpp
+ * @brief KITTI / SemanticKITTI sequence → rosbag, and the labelled points such a bag carries.
+ *
+ * Bag contents (topic: type, frame):
+ *  - `/points`: sensor_msgs/PointCloud2, frame `velodyne`, fields x y z intensity (float32), one per scan,
+ *    stamped start_stamp + times.txt;
+ *  - `/tf`: `map` → `base_link` at each scan stamp. `map` is the ground under the lidar of frame 0 (the lidar
+ *    frame of frame 0 lowered by lidar_height), `base_link` the ground under the lidar (the lidar frame
+ *    lowered by lidar_height): map → base_link = D · Tr⁻¹ · P · Tr · D⁻¹ with D the lidar_height lift;
+ *  - `/tf_static`: `base_link` → `velodyne` (lidar_height up), latched;
+ *  - `/ground_truth/points`: sensor_msgs/PointCloud2, frame `velodyne`, the scan's points with their ground
+ *    truth, for labelled frames only: x y z (float32), label (uint32, the raw SemanticKITTI label: class in the
+ *    low 16 bits, instance in the high 16), state (uint8: 0 unlabelled, 1 static, 2 moving).
+ */
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <sensor_msgs/PointCloud2.h>
+
+#include "map_aided_fusion/dataset/kitti.hpp"
+
+namespace map_aided_fusion {
+
+/// Options of writeKittiBag().
+struct KittiBagOptions
+{
+  std::string path;                      ///< the bag to write (written as PATH.partial, renamed when complete)
+  double start_stamp = 1317376800.0;     ///< s, ROS time of times.txt's 0 (KITTI's 2011-09-30; never 0)
+  double lidar_height = 1.73;            ///< m, the velodyne above the ground (KITTI's HDL-64E mount)
+  std::string points_topic = "/points";
+  std::string labels_topic = "/ground_truth/points";
+  std::string map_frame = "map";
+  std::string base_frame = "base_link";
+  std::string lidar_frame = "velodyne";
+  std::function<void(std::size_t done, std::size_t total)> progress;  ///< called after each frame, or empty
+};
+
+/// What writeKittiBag() wrote.
+struct KittiBagStats
+{
+  std::size_t scans = 0;
+  std::size_t labelled_scans = 0;
+  std::size_t points = 0;
+  std::size_t moving_points = 0;
+};
+
+/// A ground-truth point read back from `/ground_truth/points`.
+struct LabelledCloudPoint
+{
+  float x, y, z;
+  std::uint32_t label;
+  std::uint8_t state;  ///< dataset::PointState
+};
+
+/// Static converters between KITTI frames and messages (tested without a master).
+class KittiConversions
+{
+public:
+  static void toPointCloud2(const std::vector<dataset::KittiPoint>& points, const ros::Time& stamp,
+                            const std::string& frame_id, sensor_msgs::PointCloud2& msg);
+  static void toLabelledCloud(const std::vector<dataset::KittiPoint>& points, const std::vector<std::uint32_t>& labels,
+                              const ros::Time& stamp, const std::string& frame_id, sensor_msgs::PointCloud2& msg);
+  /// @throws std::runtime_error when @p msg does not have the fields toLabelledCloud() writes.
+  static std::vector<LabelledCloudPoint> fromLabelledCloud(const sensor_msgs::PointCloud2& msg);
+};
+
+/**
+ * @brief Converts a whole sequence. The bag is written to PATH.partial and renamed to PATH only when every frame
+ *        was written; on any error the partial file is removed, so no half-written bag looks complete.
+ * @throws dataset::KittiError or rosbag::BagException, naming the file at fault.
+ */
+KittiBagStats writeKittiBag(const dataset::KittiSequence& sequence, const KittiBagOptions& options);
+
+}  // namespace map_aided_fusion

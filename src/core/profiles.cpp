@@ -1,0 +1,43 @@
+#include "map_aided_fusion/core/profiles.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+const std::vector<AddedStep>& addedSteps()
+{
+  static const std::vector<AddedStep> steps{
+    { "relative_height", "a low obstacle return must stand obstacle_min_height above the lowest return around it",
+      [](const Profile& p) { return p.scan_grid.relative_height_limit > 0.0; },
+      [](Profile& p) { p.scan_grid.relative_height_limit = 0.0; } },
+    { "point_occupancy", "occupied evidence in the window cell under each obstacle return, not resampled scan cells",
+      [](const Profile& p) { return p.map_grid.point_occupancy; },
+      [](Profile& p) { p.map_grid.point_occupancy = false; } },
+    { "obstacle_clearance", "no free evidence within obstacle_clearance of an obstacle return",
+      [](const Profile& p) { return p.map_grid.obstacle_clearance > 0.0; },
+      [](Profile& p) { p.map_grid.obstacle_clearance = 0.0; } },
+    { "moving_expiry", "m({V}) goes to Omega where the scan holds no occupied mass",
+      [](const Profile& p) { return p.map_grid.fusion.moving_expiry; },
+      [](Profile& p) { p.map_grid.fusion.moving_expiry = false; } },
+    { "motion_spreading", "a small occupied region with enough V cells is one moving object: its open motion goes to {V}",
+      [](const Profile& p) { return p.map_grid.motion_share > 0.0; },
+      [](Profile& p) { p.map_grid.motion_share = 0.0; } },
+    { "motion_margin", "S or V within motion_margin of each other is decided 'occupied, motion not yet known'",
+      [](const Profile& p) { return p.map_grid.motion_margin > 0.0; },
+      [](Profile& p) { p.map_grid.motion_margin = 0.0; } },
+  };
+  return steps;
+}
+
+Profile withoutAddedSteps(Profile p)
+{
+  for (const AddedStep& s : addedSteps()) s.disable(p);
+  return p;
+}
+
+Profile paperProfile()
+{
+  return withoutAddedSteps(Profile{});
+}
+
+}  // namespace core
+}  // namespace map_aided_fusion

@@ -1,0 +1,176 @@
+#include "map_aided_fusion/eval/point_labels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace map_aided_fusion {
+namespace eval {
+
+namespace {
+
+constexpr int kThirdSweep = 2;  // index of an instance's third labelled sweep
+constexpr int kUnknownSlot = kNumCellClasses;
+
+int slotOf(std::int8_t code)
+{
+  return code >= 0 && code < kNumCellClasses ? code : kUnknownSlot;
+}
+
+}  // namespace
+
+PointLabelScorer::PointLabelScorer(double match_radius) : radius_(match_radius) {}
+
+void PointLabelScorer::add(double stamp, const ClassGrid& decision, const std::vector<LabelledPoint>& points,
+                           bool labelled)
+{
+  PointScanScore s;
+  s.stamp = stamp;
+  s.labelled = labelled;
+  const core::GridGeometry& g = decision.geometry;
+  const auto moving = static_cast<std::int8_t>(core::CellClass::kMoving);
+  for (std::int8_t d : decision.cells) s.v_cells += d == moving;
+  if (!labelled)
+  {
+    sweeps_.push_back(s);
+    return;
+  }
+  const int reach = static_cast<int>(std::ceil(radius_ / g.resolution - 1e-9));
+  std::unordered_set<std::size_t> near_moving, static_cells, moving_cells;
+  std::unordered_map<std::uint32_t, std::unordered_set<std::size_t>> instance_cells;
+  for (const LabelledPoint& lp : points)
+  {
+    core::CellIndex c;
+    if (!g.worldToCell(lp.p, c)) continue;
+    const std::size_t i = g.index(c);
+    if (lp.state == LabelState::kMoving)
+    {
+      for (int dy = -reach; dy <= reach; ++dy)
+        for (int dx = -reach; dx <= reach; ++dx)
+        {
+          const core::CellIndex n{ c.x + dx, c.y + dy };
+          if (g.contains(n)) near_moving.insert(g.index(n));
+        }
+      if (lp.obstacle)
+      {
+        moving_cells.insert(i);
+        instance_cells[lp.instance].insert(i);
+      }
+    }
+    else if (lp.state == LabelState::kStatic && lp.obstacle)
+      static_cells.insert(i);
+  }
+  for (std::size_t i = 0; i < decision.cells.size(); ++i)
+  {
+    if (decision.cells[i] != moving) continue;
+    if (!near_moving.count(i)) ++s.false_v;
+    if (static_cells.count(i) && !moving_cells.count(i)) ++s.v_on_static;
+  }
+  for (std::size_t i : moving_cells)
+  {
+    ++s.mover_cells;
+    s.mover_v_cells += decision.cells[i] == moving;
+  }
+  for (std::size_t i : static_cells)
+    if (!moving_cells.count(i)) ++s.static_cells[static_cast<std::size_t>(slotOf(decision.cells[i]))];
+  for (const auto& [id, cells] : instance_cells)
+  {
+    MovingInstance& m = instances_[id];
+    m.id = id;
+    if (m.first_seen < 0.0) m.first_seen = stamp;
+    std::size_t v = 0;
+    for (std::size_t i : cells) v += decision.cells[i] == moving;
+    if (v > 0 && m.first_v < 0.0) m.first_v = stamp;
+    ++m.sweeps;
+    m.v_share.push_back(static_cast<double>(v) / static_cast<double>(cells.size()));
+  }
+  sweeps_.push_back(s);
+}
+
+std::map<std::string, double> PointLabelScorer::summary() const
+{
+  std::map<std::string, double> m;
+  double sweeps = 0, labelled = 0, v = 0, v_unlabelled = 0, false_v = 0, v_static = 0, mover = 0, mover_v = 0;
+  std::array<double, kNumCellClasses + 1> st{};
+  for (const PointScanScore& s : sweeps_)
+  {
+    ++sweeps;
+    v += static_cast<double>(s.v_cells);
+    if (!s.labelled)
+    {
+      v_unlabelled += static_cast<double>(s.v_cells);
+      continue;
+    }
+    ++labelled;
+    false_v += static_cast<double>(s.false_v);
+    v_static += static_cast<double>(s.v_on_static);
+    mover += static_cast<double>(s.mover_cells);
+    mover_v += static_cast<double>(s.mover_v_cells);
+    for (std::size_t k = 0; k < st.size(); ++k) st[k] += static_cast<double>(s.static_cells[k]);
+  }
+  auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+  m["sweeps"] = sweeps;
+  m["labelled_sweeps"] = labelled;
+  m["v_cells_per_sweep"] = ratio(v, sweeps);
+  m["v_cells_per_unlabelled_sweep"] = ratio(v_unlabelled, sweeps - labelled);
+  m["false_v_per_labelled_sweep"] = ratio(false_v, labelled);
+  m["v_on_static_per_labelled_sweep"] = ratio(v_static, labelled);
+  m["mover_cells_v_share"] = ratio(mover_v, mover);
+  double min_share = -1.0, delay = 0.0;
+  int detected = 0, never = 0;
+  for (const auto& [id, inst] : instances_)
+  {
+    for (std::size_t k = kThirdSweep; k < inst.v_share.size(); ++k)
+      min_share = min_share < 0.0 ? inst.v_share[k] : std::min(min_share, inst.v_share[k]);
+    if (inst.first_v >= 0.0)
+    {
+      delay += inst.first_v - inst.first_seen;
+      ++detected;
+    }
+    else
+      ++never;
+  }
+  m["mover_min_v_share_from_third_sweep"] = min_share;
+  m["mover_first_v_delay_s"] = detected ? delay / detected : -1.0;
+  m["movers"] = static_cast<double>(instances_.size());
+  m["movers_never_v"] = never;
+  double total_static = 0;
+  for (double x : st) total_static += x;
+  for (int c = 0; c < kNumCellClasses; ++c)
+    m["static_cells." + std::string(core::kCellClassNames[static_cast<std::size_t>(c)])] = ratio(st[c], total_static);
+  m["static_cells.unknown"] = ratio(st[kUnknownSlot], total_static);
+  return m;
+}
+
+std::string pointLabelMarkdown(const std::vector<std::pair<std::string, const PointLabelScorer*>>& rows)
+{
+  std::ostringstream out;
+  out << std::fixed;
+  out << "| variant | sweeps (labelled) | V cells / sweep | false V / labelled sweep | V on static / labelled sweep "
+         "| mover cells decided V | mover min V share (3rd sweep on) | first V delay (s) | static obstacle cells "
+         "F / C / N / S / V / undecided |\n";
+  out << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n";
+  for (const auto& [name, scorer] : rows)
+  {
+    const auto m = scorer->summary();
+    auto f = [&](const std::string& k, int digits) {
+      std::ostringstream s;
+      s << std::fixed << std::setprecision(digits) << m.at(k);
+      return s.str();
+    };
+    out << "| " << name << " | " << f("sweeps", 0) << " (" << f("labelled_sweeps", 0) << ") | "
+        << f("v_cells_per_sweep", 1) << " | " << f("false_v_per_labelled_sweep", 1) << " | "
+        << f("v_on_static_per_labelled_sweep", 1) << " | " << f("mover_cells_v_share", 2) << " | "
+        << (m.at("mover_min_v_share_from_third_sweep") < 0 ? std::string("n/a") : f("mover_min_v_share_from_third_sweep", 2))
+        << " | " << (m.at("mover_first_v_delay_s") < 0 ? std::string("never") : f("mover_first_v_delay_s", 2)) << " | "
+        << f("static_cells.F", 2) << " / " << f("static_cells.C", 2) << " / " << f("static_cells.N", 2) << " / "
+        << f("static_cells.S", 2) << " / " << f("static_cells.V", 2) << " / " << f("static_cells.unknown", 2) << " |\n";
+  }
+  return out.str();
+}
+
+}  // namespace eval
+}  // namespace map_aided_fusion

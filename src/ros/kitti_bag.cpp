@@ -1,0 +1,187 @@
+#include "map_aided_fusion/ros/kitti_bag.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <rosbag/bag.h>
+#include <tf2_msgs/TFMessage.h>
+
+namespace map_aided_fusion {
+
+namespace {
+
+constexpr std::uint32_t kPointStep = 16;         // x y z intensity, float32
+constexpr std::uint32_t kLabelledPointStep = 17;  // x y z float32, label uint32, state uint8
+constexpr std::uint32_t kLabelOffset = 12;
+constexpr std::uint32_t kStateOffset = 16;
+
+sensor_msgs::PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type)
+{
+  sensor_msgs::PointField f;
+  f.name = name;
+  f.offset = offset;
+  f.datatype = type;
+  f.count = 1;
+  return f;
+}
+
+boost::shared_ptr<ros::M_string> latchedTfHeader()
+{
+  auto h = boost::make_shared<ros::M_string>();
+  (*h)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
+  (*h)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
+  (*h)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
+  (*h)["callerid"] = "/kitti_to_bag";
+  (*h)["latching"] = "1";
+  return h;
+}
+
+geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& t, const ros::Time& stamp,
+                                            const std::string& parent, const std::string& child)
+{
+  geometry_msgs::TransformStamped m;
+  m.header.stamp = stamp;
+  m.header.frame_id = parent;
+  m.child_frame_id = child;
+  m.transform.translation.x = t.translation().x();
+  m.transform.translation.y = t.translation().y();
+  m.transform.translation.z = t.translation().z();
+  const Eigen::Quaterniond q(t.rotation());
+  m.transform.rotation.w = q.w();
+  m.transform.rotation.x = q.x();
+  m.transform.rotation.y = q.y();
+  m.transform.rotation.z = q.z();
+  return m;
+}
+
+void header(sensor_msgs::PointCloud2& msg, const ros::Time& stamp, const std::string& frame_id, std::size_t n,
+            std::uint32_t step)
+{
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame_id;
+  msg.height = 1;
+  msg.width = static_cast<std::uint32_t>(n);
+  msg.is_bigendian = false;
+  msg.is_dense = false;
+  msg.point_step = step;
+  msg.row_step = step * msg.width;
+  msg.data.resize(static_cast<std::size_t>(msg.row_step));
+}
+
+}  // namespace
+
+void KittiConversions::toPointCloud2(const std::vector<dataset::KittiPoint>& points, const ros::Time& stamp,
+                                     const std::string& frame_id, sensor_msgs::PointCloud2& msg)
+{
+  header(msg, stamp, frame_id, points.size(), kPointStep);
+  msg.fields = { field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
+                 field("z", 8, sensor_msgs::PointField::FLOAT32),
+                 field("intensity", 12, sensor_msgs::PointField::FLOAT32) };
+  static_assert(sizeof(dataset::KittiPoint) == kPointStep, "KITTI points are 16 bytes");
+  if (!points.empty()) std::memcpy(msg.data.data(), points.data(), msg.data.size());
+}
+
+void KittiConversions::toLabelledCloud(const std::vector<dataset::KittiPoint>& points,
+                                       const std::vector<std::uint32_t>& labels, const ros::Time& stamp,
+                                       const std::string& frame_id, sensor_msgs::PointCloud2& msg)
+{
+  if (labels.size() != points.size()) throw std::invalid_argument("toLabelledCloud: one label per point");
+  header(msg, stamp, frame_id, points.size(), kLabelledPointStep);
+  msg.fields = { field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
+                 field("z", 8, sensor_msgs::PointField::FLOAT32),
+                 field("label", kLabelOffset, sensor_msgs::PointField::UINT32),
+                 field("state", kStateOffset, sensor_msgs::PointField::UINT8) };
+  std::uint8_t* p = msg.data.data();
+  for (std::size_t k = 0; k < points.size(); ++k, p += kLabelledPointStep)
+  {
+    std::memcpy(p, &points[k], 3 * sizeof(float));
+    std::memcpy(p + kLabelOffset, &labels[k], sizeof(std::uint32_t));
+    p[kStateOffset] = static_cast<std::uint8_t>(dataset::stateOf(labels[k]));
+  }
+}
+
+std::vector<LabelledCloudPoint> KittiConversions::fromLabelledCloud(const sensor_msgs::PointCloud2& msg)
+{
+  auto offset = [&](const std::string& name, std::uint8_t type) -> std::uint32_t {
+    for (const auto& f : msg.fields)
+      if (f.name == name && f.datatype == type) return f.offset;
+    throw std::runtime_error("labelled cloud without a " + name + " field of the expected type");
+  };
+  const std::uint32_t ox = offset("x", sensor_msgs::PointField::FLOAT32);
+  const std::uint32_t oy = offset("y", sensor_msgs::PointField::FLOAT32);
+  const std::uint32_t oz = offset("z", sensor_msgs::PointField::FLOAT32);
+  const std::uint32_t ol = offset("label", sensor_msgs::PointField::UINT32);
+  const std::uint32_t os = offset("state", sensor_msgs::PointField::UINT8);
+  const std::size_t n = static_cast<std::size_t>(msg.width) * msg.height;
+  if (msg.point_step < kLabelledPointStep || msg.data.size() < n * msg.point_step || msg.is_bigendian)
+    throw std::runtime_error("labelled cloud: inconsistent size or big-endian data");
+  std::vector<LabelledCloudPoint> out(n);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    const std::uint8_t* p = msg.data.data() + k * msg.point_step;
+    std::memcpy(&out[k].x, p + ox, sizeof(float));
+    std::memcpy(&out[k].y, p + oy, sizeof(float));
+    std::memcpy(&out[k].z, p + oz, sizeof(float));
+    std::memcpy(&out[k].label, p + ol, sizeof(std::uint32_t));
+    out[k].state = p[os];
+  }
+  return out;
+}
+
+KittiBagStats writeKittiBag(const dataset::KittiSequence& sequence, const KittiBagOptions& o)
+{
+  if (!(o.start_stamp > 0.0)) throw std::invalid_argument("start_stamp must be > 0 (a zero stamp is rejected)");
+  const std::string partial = o.path + ".partial";
+  KittiBagStats stats;
+  try
+  {
+    rosbag::Bag bag(partial, rosbag::bagmode::Write);
+    bag.setCompression(rosbag::compression::LZ4);
+    Eigen::Isometry3d lift = Eigen::Isometry3d::Identity();
+    lift.translation().z() = o.lidar_height;
+    ros::Time first;
+    first.fromSec(o.start_stamp + sequence.time(0));
+    tf2_msgs::TFMessage statics;
+    statics.transforms.push_back(toTransform(lift, first, o.base_frame, o.lidar_frame));
+    bag.write("/tf_static", first, statics, latchedTfHeader());
+    const Eigen::Isometry3d lift_inv = lift.inverse();
+    for (std::size_t k = 0; k < sequence.size(); ++k)
+    {
+      ros::Time stamp;
+      stamp.fromSec(o.start_stamp + sequence.time(k));
+      const auto points = sequence.readScan(k);
+      const auto labels = sequence.readLabels(k, points.size());
+      tf2_msgs::TFMessage tf;
+      tf.transforms.push_back(toTransform(lift * sequence.lidarPose(k) * lift_inv, stamp, o.map_frame, o.base_frame));
+      bag.write("/tf", stamp, tf);
+      sensor_msgs::PointCloud2 cloud;
+      KittiConversions::toPointCloud2(points, stamp, o.lidar_frame, cloud);
+      bag.write(o.points_topic, stamp, cloud);
+      if (!labels.empty())
+      {
+        sensor_msgs::PointCloud2 truth;
+        KittiConversions::toLabelledCloud(points, labels, stamp, o.lidar_frame, truth);
+        bag.write(o.labels_topic, stamp, truth);
+        ++stats.labelled_scans;
+        for (std::uint32_t l : labels) stats.moving_points += dataset::stateOf(l) == dataset::PointState::kMoving;
+      }
+      ++stats.scans;
+      stats.points += points.size();
+      if (o.progress) o.progress(k + 1, sequence.size());
+    }
+    bag.close();
+  }
+  catch (...)
+  {
+    std::error_code ec;
+    std::filesystem::remove(partial, ec);
+    throw;
+  }
+  std::filesystem::rename(partial, o.path);
+  return stats;
+}
+
+}  // namespace map_aided_fusion
