@@ -358,7 +358,7 @@ MAF_INLINE void pignistic(const T (&m)[kSubsets], T (&p)[FrameMG::kSize])
  * Rounding hygiene once per step: negative masses (float rounding, ~1e-8) are set to 0 and what the cell
  * lacks or has in excess of 1 goes to Ω, so that 10^5 steps do not drift from a mass function. The drift is
  * rounding (|Σm − 1| ~ 1e-7 per step), so moving it to ignorance changes no decision; it costs one max and
- * one add per subset.
+ * one add per subset. A cell with no ignorance left (m(Ω) would go negative) has its other masses scaled by 1/Σ.
  */
 template <typename T>
 MAF_INLINE void renormalise(T (&m)[kSubsets])
@@ -371,8 +371,14 @@ MAF_INLINE void renormalise(T (&m)[kSubsets])
     m[a] = select(m[a] > zero, m[a], zero);
     sum += m[a];
   }
-  const T omega = m[kSubsets - 1] + (splat<T>(1.0f) - sum);
+  const T one = splat<T>(1.0f);
+  const T others = sum - m[kSubsets - 1];
+  const T omega = m[kSubsets - 1] + (one - sum);
   m[kSubsets - 1] = select(omega > zero, omega, zero);
+  // Rounding excess in a cell without ignorance (m(Ω) would go negative): scale the rest down instead.
+  const T scale = select(omega < zero, one / select(others > zero, others, one), one);
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets - 1; ++a) m[a] *= scale;
 }
 
 /// Mass on the non-empty subsets of {C, N, S, V}.

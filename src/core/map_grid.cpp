@@ -269,20 +269,29 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
   const float* ps = betp[FrameMG::kSize - 2].data();
   const float* pv = betp[FrameMG::kSize - 1].data();
   const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
+  const float* pf = betp[0].data();
+  const float* omega = grid.plane(FrameMG::kOmega);
+  const float t = static_cast<float>(params.decision_threshold);
+  const auto unknown = static_cast<std::int8_t>(CellClass::kUnknown);
   for (std::size_t i = 0; i < out.size(); ++i)
-    if ((out[i] == stopped || out[i] == moving) && std::abs(ps[i] - pv[i]) < margin)
-      out[i] = static_cast<std::int8_t>(CellClass::kOccupied);
+  {
+    const bool tie = (out[i] == stopped || out[i] == moving) && std::abs(ps[i] - pv[i]) < margin;
+    const bool unclassified = out[i] == unknown && omega[i] < 1.0f - kVacuousTolerance && 1.0f - pf[i] >= t;
+    if (tie || unclassified) out[i] = static_cast<std::int8_t>(CellClass::kOccupied);
+  }
 }
 
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
-                         int max_cells, double threshold)
+                         int max_cells, double threshold, double margin)
 {
   if (share <= 0.0) return 0;
   const GridGeometry& g = grid.geometry();
   const std::size_t n = g.numCells();
   const float* so = scan.plane(FrameSG::kO);
+  const float* ps = betp[FrameMG::kSize - 2].data();
   const float* pv = betp[FrameMG::kSize - 1].data();
   const float t = static_cast<float>(threshold);
+  const float m = static_cast<float>(margin);
   thread_local std::vector<std::uint8_t> seen;
   thread_local std::vector<std::size_t> stack, region;
   seen.assign(n, 0);
@@ -299,7 +308,7 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
       const std::size_t i = stack.back();
       stack.pop_back();
       region.push_back(i);
-      moving += pv[i] >= t;
+      moving += pv[i] >= t && pv[i] - ps[i] > m;
       const CellIndex c = g.cellOf(i);
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx)
@@ -522,7 +531,8 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   if (params_.rates_per_second && scans_ > 0) fp.discount = fp.discount.compounded(std::max(0.0, stamp - last_stamp_));
   FusionStepStats stats;
   fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_);
-  spreadMotion(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells, params_.decision_threshold);
+  spreadMotion(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells, params_.decision_threshold,
+               params_.motion_margin);
   t.fusion = secondsSince(t0);
 
   last_stamp_ = stamp;

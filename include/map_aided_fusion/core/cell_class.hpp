@@ -21,8 +21,8 @@ enum class CellClass : std::int8_t
   kInfrastructure = 2,  ///< N: non-mapped infrastructure (poles, bins, trees, unmapped buildings)
   kStopped = 3,         ///< S: temporarily stopped object
   kMoving = 4,          ///< V: moving object
-  /// Decision layer only: occupied, motion not yet known (S and V within motion_margin of each other; the step
-  /// "motion margin"). Never a ground-truth class.
+  /// Decision layer only: occupied, motion (or class) not yet known (the step "motion margin": S and V within
+  /// motion_margin of each other, or occupied with no class decided). Never a ground-truth class.
   kOccupied = 5,
 };
 

@@ -68,7 +68,7 @@ struct MapGridParams
   /**
    * Step "motion spreading" (not in the paper): after the step, each connected region (8-connectivity) of cells
    * the scan sees occupied, of at most motion_max_cells cells, in which at least this share of cells has
-   * BetP(V) ≥ decision_threshold, is one moving object: in each of its cells the occupied mass that still leaves
+   * BetP(V) ≥ decision_threshold and BetP(V) − BetP(S) > motion_margin, is one moving object: in each of its cells the occupied mass that still leaves
    * the motion open (focal sets holding V and other classes) goes to {V}. Conflict only marks the cells an object
    * enters; the rest of a mover (the cells it still covers, and all of it when it moves away from the sensor) would
    * otherwise stay undecided. In [0, 1]; 0 disables it.
@@ -77,8 +77,9 @@ struct MapGridParams
   int motion_max_cells = 200;  ///< largest region motion spreading treats as one object, cells (≥ 1)
   /**
    * Step "motion margin" (not in the paper): a cell whose decision would be S or V with |BetP(S) − BetP(V)| below
-   * this is decided CellClass::kOccupied, "occupied, motion not yet known". An object first seen already in place
-   * (no earlier free evidence) has its mass on {S, V}; the counter grows at once and specialisation would tip it to S
+   * this, or that no class decides although its occupied BetP (1 − BetP(F)) reaches decision_threshold, is decided
+   * CellClass::kOccupied, "occupied, motion (or class) not yet known". An object first seen already in place (no
+   * earlier free evidence) has its mass on {S, V}; the counter grows at once and specialisation would tip it to S
    * by a hair. In [0, 1]; 0 disables it.
    */
   double motion_margin = 0.1;
@@ -180,13 +181,16 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
 
 /**
  * @brief The step "motion spreading" on @p grid and its BetP @p betp (both updated in place): see
- *        MapGridParams::motion_share. @p scan is the scan in the grid's cells. Returns the number of regions spread.
+ *        MapGridParams::motion_share. @p scan is the scan in the grid's cells. A cell counts as V when
+ *        BetP(V) ≥ @p threshold and BetP(V) − BetP(S) > @p margin (an open {S, V} is not motion). Returns the number
+ *        of regions spread.
  */
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
-                         int max_cells, double threshold);
+                         int max_cells, double threshold, double margin);
 
 /// Decision per cell with every decision parameter of @p params: the threshold, then the step "motion margin"
-/// (S or V decisions within motion_margin of each other become CellClass::kOccupied).
+/// (S or V decisions within motion_margin of each other, and occupied cells no class decides, become
+/// CellClass::kOccupied).
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
             std::vector<std::int8_t>& out);
 
