@@ -23,6 +23,10 @@ install(TARGETS evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 if(CATKIN_ENABLE_TESTING)
   add_rostest_gtest(test_demo_scores test/demo.test test/ros/test_demo_scores.cpp)
   target_link_libraries(test_demo_scores map_aided_fusion_eval ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-  add_dependencies(tests simulate evaluate map_aided_fusion_fusion_nodelet map_aided_fusion_scan_grid_nodelet
+  add_rostest_gtest(test_kitti_replay test/kitti_replay.test test/ros/test_kitti_replay.cpp)
+  target_link_libraries(test_kitti_replay map_aided_fusion_eval map_aided_fusion_dataset_ros ${catkin_LIBRARIES}
+    ${GTEST_LIBRARIES})
+  target_compile_definitions(test_kitti_replay PRIVATE MAF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
+  add_dependencies(tests kitti_to_bag simulate evaluate map_aided_fusion_fusion_nodelet map_aided_fusion_scan_grid_nodelet
     map_aided_fusion_prior_grid_nodelet)
 endif()

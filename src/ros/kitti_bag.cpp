@@ -131,6 +131,29 @@ std::vector<LabelledCloudPoint> KittiConversions::fromLabelledCloud(const sensor
   return out;
 }
 
+std::vector<eval::LabelledPoint> KittiConversions::toScoredPoints(const sensor_msgs::PointCloud2& msg,
+                                                                  const Eigen::Isometry3d& map_sensor,
+                                                                  const Eigen::Isometry3d& base_sensor,
+                                                                  double obstacle_low, double obstacle_high)
+{
+  const auto points = fromLabelledCloud(msg);
+  std::vector<eval::LabelledPoint> out;
+  out.reserve(points.size());
+  for (const LabelledCloudPoint& p : points)
+  {
+    const Eigen::Vector3d v(p.x, p.y, p.z);
+    const Eigen::Vector3d m = map_sensor * v;
+    const double z = (base_sensor * v).z();
+    eval::LabelledPoint lp;
+    lp.p = core::Point2{ m.x(), m.y() };
+    lp.state = static_cast<eval::LabelState>(p.state);
+    lp.obstacle = z >= obstacle_low && z <= obstacle_high && !dataset::isGroundClass(dataset::semanticClass(p.label));
+    lp.instance = lp.state == eval::LabelState::kMoving ? p.label : 0;
+    out.push_back(lp);
+  }
+  return out;
+}
+
 KittiBagStats writeKittiBag(const dataset::KittiSequence& sequence, const KittiBagOptions& o)
 {
   if (!(o.start_stamp > 0.0)) throw std::invalid_argument("start_stamp must be > 0 (a zero stamp is rejected)");

@@ -290,25 +290,10 @@ Eigen::Isometry3d toIsometry(const geometry_msgs::TransformStamped& t)
 std::vector<eval::LabelledPoint> toLabelledPoints(const sensor_msgs::PointCloud2& msg, tf2::BufferCore& tf,
                                                   const Options& o, const core::ScanGridParams& sg)
 {
-  const auto map_sensor = toIsometry(tf.lookupTransform(o.map_frame, msg.header.frame_id, msg.header.stamp));
-  const auto base_sensor = toIsometry(tf.lookupTransform(o.base_frame, msg.header.frame_id, msg.header.stamp));
-  const double lo = sg.ground_height + sg.obstacle_min_height, hi = sg.ground_height + sg.obstacle_max_height;
-  std::vector<eval::LabelledPoint> out;
-  const auto points = KittiConversions::fromLabelledCloud(msg);
-  out.reserve(points.size());
-  for (const LabelledCloudPoint& p : points)
-  {
-    const Eigen::Vector3d v(p.x, p.y, p.z);
-    const Eigen::Vector3d m = map_sensor * v;
-    const double z = (base_sensor * v).z();
-    eval::LabelledPoint lp;
-    lp.p = core::Point2{ m.x(), m.y() };
-    lp.state = static_cast<eval::LabelState>(p.state);
-    lp.obstacle = z >= lo && z <= hi && !dataset::isGroundClass(dataset::semanticClass(p.label));
-    lp.instance = lp.state == eval::LabelState::kMoving ? p.label : 0;
-    out.push_back(lp);
-  }
-  return out;
+  return KittiConversions::toScoredPoints(
+      msg, toIsometry(tf.lookupTransform(o.map_frame, msg.header.frame_id, msg.header.stamp)),
+      toIsometry(tf.lookupTransform(o.base_frame, msg.header.frame_id, msg.header.stamp)),
+      sg.ground_height + sg.obstacle_min_height, sg.ground_height + sg.obstacle_max_height);
 }
 
 void writeSnapshotNpy(const fs::path& dir, const std::string& stem, const eval::ClassGrid& g)

@@ -23,6 +23,7 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include "map_aided_fusion/dataset/kitti.hpp"
+#include "map_aided_fusion/eval/point_labels.hpp"
 
 namespace map_aided_fusion {
 
@@ -67,6 +68,16 @@ public:
                               const ros::Time& stamp, const std::string& frame_id, sensor_msgs::PointCloud2& msg);
   /// @throws std::runtime_error when @p msg does not have the fields toLabelledCloud() writes.
   static std::vector<LabelledCloudPoint> fromLabelledCloud(const sensor_msgs::PointCloud2& msg);
+  /**
+   * @brief A `/ground_truth/points` cloud → the scorer's points in the map frame. A point is an obstacle when its
+   *        height in base_link is in [@p obstacle_low, @p obstacle_high] and its class is not a ground class.
+   * @param map_sensor   map ← cloud frame at the cloud's stamp
+   * @param base_sensor  base_link ← cloud frame
+   */
+  static std::vector<eval::LabelledPoint> toScoredPoints(const sensor_msgs::PointCloud2& msg,
+                                                         const Eigen::Isometry3d& map_sensor,
+                                                         const Eigen::Isometry3d& base_sensor, double obstacle_low,
+                                                         double obstacle_high);
 };
 
 /**
