@@ -1,11 +1,13 @@
 // PriorGridParams validation and the published window (cap on the message size).
 #include <gtest/gtest.h>
 
+#include <map>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
 
 #include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
 
 namespace {
@@ -133,3 +135,44 @@ TEST(PublishedWindow, CappedToASquareAroundTheCentre)
 }
 
 }  // namespace
+
+namespace {
+
+/// name → value of every parameter of @p p (bools as 0/1), through the shared parameter list.
+template <class Params>
+std::map<std::string, double> valuesOf(Params p)
+{
+  std::map<std::string, double> out;
+  core::forEachParam(p, [&](const std::string& name, auto& v) { out[name] = static_cast<double>(v); });
+  return out;
+}
+
+/// @p Params loaded from the YAML file @p path (every key of the parameter list must be in the file).
+template <class Params>
+Params loadFile(const std::string& path)
+{
+  const YAML::Node yaml = YAML::LoadFile(path);
+  Params p;
+  core::forEachParam(p, [&](const std::string& name, auto& value) {
+    const YAML::Node n = yaml[name];
+    EXPECT_TRUE(n) << path << " lacks " << name;
+    if (n) value = n.as<std::remove_reference_t<decltype(value)>>();
+  });
+  return p;
+}
+
+}  // namespace
+
+TEST(Profiles, ConfigFilesHoldTheDefaultAndThePaperProfiles)
+{
+  const std::string dir = std::string(MAF_PACKAGE_DIR) + "/config/";
+  const core::Profile def = core::defaultProfile(), paper = core::paperProfile();
+  EXPECT_EQ(valuesOf(loadFile<core::MapGridParams>(dir + "fusion.yaml")), valuesOf(def.map_grid));
+  EXPECT_EQ(valuesOf(loadFile<core::ScanGridParams>(dir + "scan_grid.yaml")), valuesOf(def.scan_grid));
+  EXPECT_EQ(valuesOf(loadFile<core::MapGridParams>(dir + "paper/fusion.yaml")), valuesOf(paper.map_grid));
+  EXPECT_EQ(valuesOf(loadFile<core::ScanGridParams>(dir + "paper/scan_grid.yaml")), valuesOf(paper.scan_grid));
+  EXPECT_NE(valuesOf(paper.map_grid), valuesOf(def.map_grid));
+  // The PriorGrid is the same in both profiles.
+  const YAML::Node a = YAML::LoadFile(dir + "prior_grid.yaml"), b = YAML::LoadFile(dir + "paper/prior_grid.yaml");
+  for (const auto& kv : a) EXPECT_EQ(YAML::Dump(kv.second), YAML::Dump(b[kv.first.as<std::string>()])) << kv.first;
+}
