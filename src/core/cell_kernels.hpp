@@ -375,7 +375,8 @@ MAF_INLINE void renormalise(T (&m)[kSubsets])
   const T others = sum - m[kSubsets - 1];
   const T omega = m[kSubsets - 1] + (one - sum);
   m[kSubsets - 1] = select(omega > zero, omega, zero);
-  // Rounding excess in a cell without ignorance (m(Ω) would go negative): scale the rest down instead.
+  // Rounding excess in a cell without ignorance (m(Ω) would go negative, rare): scale the rest down instead.
+  if (horizontalSum(select(omega < zero, one, zero)) == 0.0f) return;
   const T scale = select(omega < zero, one / select(others > zero, others, one), one);
   MAF_UNROLL
   for (int a = 0; a < kSubsets - 1; ++a) m[a] *= scale;

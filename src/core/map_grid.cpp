@@ -45,13 +45,6 @@ void copyCell(const MassGrid<Frame>& from, std::size_t i, MassGrid<Frame>& to, s
   for (int a = 0; a < Frame::kNumSubsets; ++a) to.plane(static_cast<Subset>(a))[j] = from.plane(static_cast<Subset>(a))[i];
 }
 
-/// Cells marked occupied by one projectScan() call (thread-local scratch, reused between scans).
-std::vector<std::size_t>& projectScratch()
-{
-  thread_local std::vector<std::size_t> cells;
-  return cells;
-}
-
 }  // namespace
 
 void MapGridParams::validate() const
@@ -150,8 +143,6 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
           }
         }
       }
-  std::vector<std::size_t>& occupied = projectScratch();
-  occupied.clear();
   if (points)
   {
     // Point occupancy: each return marks the window cell under it with its scan cell's occupied mass.
@@ -164,7 +155,6 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
       if (o <= 0.0f) continue;
       if (!window.worldToCell(Point2{ pose.x + c * vx - s * vy, pose.y + s * vx + c * vy }, wc)) continue;
       const std::size_t j = window.index(wc);
-      if (d_o[j] == 0.0f) occupied.push_back(j);
       if (o > d_o[j])
       {
         df[j] = 0.0f;
@@ -187,20 +177,44 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
     }
   }
   if (clearance_cells <= 0) return;
-  // Obstacle clearance: no free evidence next to an occupied cell.
-  if (!points)
-    for (std::size_t j = 0; j < window.numCells(); ++j)
-      if (d_o[j] > 0.0f) occupied.push_back(j);
-  for (const std::size_t j : occupied)
+  // Obstacle clearance: no free evidence within clearance_cells (square) of an occupied cell; a separable running
+  // count (along rows, then down the columns, row by row), linear in the window whatever the number of occupied cells.
+  thread_local std::vector<std::uint8_t> rows;
+  thread_local std::vector<int> column;
+  const std::size_t n = window.numCells();
+  const std::size_t ws = static_cast<std::size_t>(w);
+  if (rows.size() < n) rows.resize(n);
+  column.assign(ws, 0);
+  const int k = clearance_cells;
+  for (int y = 0; y < h; ++y)
   {
-    const int cx = static_cast<int>(j % static_cast<std::size_t>(w)), cy = static_cast<int>(j / static_cast<std::size_t>(w));
-    for (int y = std::max(0, cy - clearance_cells); y <= std::min(h - 1, cy + clearance_cells); ++y)
-      for (int x = std::max(0, cx - clearance_cells); x <= std::min(w - 1, cx + clearance_cells); ++x)
+    const std::size_t r = static_cast<std::size_t>(y) * ws;
+    int count = 0;
+    for (int x = 0; x < std::min(w, k); ++x) count += d_o[r + x] > 0.0f;
+    for (int x = 0; x < w; ++x)
+    {
+      if (x + k < w) count += d_o[r + x + k] > 0.0f;
+      if (x - k - 1 >= 0) count -= d_o[r + x - k - 1] > 0.0f;
+      rows[r + x] = count > 0;
+    }
+  }
+  for (int y = 0; y < std::min(h, k); ++y)
+    for (std::size_t x = 0; x < ws; ++x) column[x] += rows[static_cast<std::size_t>(y) * ws + x];
+  for (int y = 0; y < h; ++y)
+  {
+    const std::uint8_t* add = y + k < h ? rows.data() + static_cast<std::size_t>(y + k) * ws : nullptr;
+    const std::uint8_t* sub = y - k - 1 >= 0 ? rows.data() + static_cast<std::size_t>(y - k - 1) * ws : nullptr;
+    float* f = df + static_cast<std::size_t>(y) * ws;
+    float* u = dw + static_cast<std::size_t>(y) * ws;
+    for (std::size_t x = 0; x < ws; ++x)
+    {
+      column[x] += (add ? add[x] : 0) - (sub ? sub[x] : 0);
+      if (column[x] > 0)
       {
-        const std::size_t n = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-        dw[n] += df[n];
-        df[n] = 0.0f;
+        u[x] += f[x];
+        f[x] = 0.0f;
       }
+    }
   }
 }
 
