@@ -131,6 +131,15 @@ std::vector<LabelledCloudPoint> KittiConversions::fromLabelledCloud(const sensor
   return out;
 }
 
+Eigen::Isometry3d KittiConversions::toIsometry(const geometry_msgs::TransformStamped& t)
+{
+  Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
+  const auto& q = t.transform.rotation;
+  s.linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+  s.translation() = Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
+  return s;
+}
+
 std::vector<eval::LabelledPoint> KittiConversions::toScoredPoints(const sensor_msgs::PointCloud2& msg,
                                                                   const Eigen::Isometry3d& map_sensor,
                                                                   const Eigen::Isometry3d& base_sensor,

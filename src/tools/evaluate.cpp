@@ -277,22 +277,13 @@ std::optional<core::PriorWindow> loadPrior(const Options& o, const YAML::Node& p
   return window;
 }
 
-Eigen::Isometry3d toIsometry(const geometry_msgs::TransformStamped& t)
-{
-  Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
-  const auto& q = t.transform.rotation;
-  s.linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
-  s.translation() = Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
-  return s;
-}
-
 /// The labelled points of one sweep in the map frame, flagged as obstacles the way the sensor model would.
 std::vector<eval::LabelledPoint> toLabelledPoints(const sensor_msgs::PointCloud2& msg, tf2::BufferCore& tf,
                                                   const Options& o, const core::ScanGridParams& sg)
 {
   return KittiConversions::toScoredPoints(
-      msg, toIsometry(tf.lookupTransform(o.map_frame, msg.header.frame_id, msg.header.stamp)),
-      toIsometry(tf.lookupTransform(o.base_frame, msg.header.frame_id, msg.header.stamp)),
+      msg, KittiConversions::toIsometry(tf.lookupTransform(o.map_frame, msg.header.frame_id, msg.header.stamp)),
+      KittiConversions::toIsometry(tf.lookupTransform(o.base_frame, msg.header.frame_id, msg.header.stamp)),
       sg.ground_height + sg.obstacle_min_height, sg.ground_height + sg.obstacle_max_height);
 }
 
@@ -510,11 +501,11 @@ int main(int argc, char** argv)
       {
         if (!v->builder_ready)
         {
-          v->builder.configure(v->scan_params, toIsometry(sensor));
+          v->builder.configure(v->scan_params, KittiConversions::toIsometry(sensor));
           v->builder_ready = true;
         }
         else
-          v->builder.setSensorPose(toIsometry(sensor));
+          v->builder.setSensorPose(KittiConversions::toIsometry(sensor));
         v->builder.build(pv, v->scan);
         const core::ObstaclePoints obstacles = v->builder.obstaclePoints();
         v->grid.update(v->scan, pose, t, v->use_prior ? &*prior : nullptr, nullptr, &obstacles);

@@ -35,15 +35,6 @@ double param(const std::string& name)
   return v;
 }
 
-Eigen::Isometry3d toIsometry(const geometry_msgs::TransformStamped& t)
-{
-  Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
-  const auto& q = t.transform.rotation;
-  s.linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
-  s.translation() = Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
-  return s;
-}
-
 TEST(KittiReplay, LiveDecisionsMeetTheMovingTargets)
 {
   std::string sequence;
@@ -114,8 +105,8 @@ TEST(KittiReplay, LiveDecisionsMeetTheMovingTargets)
     {
       const auto& c = it->second;
       points = KittiConversions::toScoredPoints(
-          c, toIsometry(tf.lookupTransform("map", c.header.frame_id, c.header.stamp)),
-          toIsometry(tf.lookupTransform("base_link", c.header.frame_id, c.header.stamp)),
+          c, KittiConversions::toIsometry(tf.lookupTransform("map", c.header.frame_id, c.header.stamp)),
+          KittiConversions::toIsometry(tf.lookupTransform("base_link", c.header.frame_id, c.header.stamp)),
           sg.ground_height + sg.obstacle_min_height, sg.ground_height + sg.obstacle_max_height);
       ++matched_labelled;
     }

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include "map_aided_fusion/dataset/kitti.hpp"
@@ -68,6 +69,8 @@ public:
                               const ros::Time& stamp, const std::string& frame_id, sensor_msgs::PointCloud2& msg);
   /// @throws std::runtime_error when @p msg does not have the fields toLabelledCloud() writes.
   static std::vector<LabelledCloudPoint> fromLabelledCloud(const sensor_msgs::PointCloud2& msg);
+  /// A tf transform → Eigen.
+  static Eigen::Isometry3d toIsometry(const geometry_msgs::TransformStamped& t);
   /**
    * @brief A `/ground_truth/points` cloud → the scorer's points in the map frame. A point is an obstacle when its
    *        height in base_link is in [@p obstacle_low, @p obstacle_high] and its class is not a ground class.
