@@ -9,6 +9,8 @@
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "map_aided_fusion/ros/bag_writing.hpp"
+
 namespace map_aided_fusion {
 
 namespace {
@@ -17,27 +19,6 @@ constexpr std::uint32_t kPointStep = 16;         // x y z intensity, float32
 constexpr std::uint32_t kLabelledPointStep = 17;  // x y z float32, label uint32, state uint8
 constexpr std::uint32_t kLabelOffset = 12;
 constexpr std::uint32_t kStateOffset = 16;
-
-sensor_msgs::PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type)
-{
-  sensor_msgs::PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = type;
-  f.count = 1;
-  return f;
-}
-
-boost::shared_ptr<ros::M_string> latchedTfHeader()
-{
-  auto h = boost::make_shared<ros::M_string>();
-  (*h)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
-  (*h)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
-  (*h)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
-  (*h)["callerid"] = "/kitti_to_bag";
-  (*h)["latching"] = "1";
-  return h;
-}
 
 geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& t, const ros::Time& stamp,
                                             const std::string& parent, const std::string& child)
@@ -77,9 +58,9 @@ void KittiConversions::toPointCloud2(const std::vector<dataset::KittiPoint>& poi
                                      const std::string& frame_id, sensor_msgs::PointCloud2& msg)
 {
   header(msg, stamp, frame_id, points.size(), kPointStep);
-  msg.fields = { field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
-                 field("z", 8, sensor_msgs::PointField::FLOAT32),
-                 field("intensity", 12, sensor_msgs::PointField::FLOAT32) };
+  msg.fields = { pointField("x", 0, sensor_msgs::PointField::FLOAT32), pointField("y", 4, sensor_msgs::PointField::FLOAT32),
+                 pointField("z", 8, sensor_msgs::PointField::FLOAT32),
+                 pointField("intensity", 12, sensor_msgs::PointField::FLOAT32) };
   static_assert(sizeof(dataset::KittiPoint) == kPointStep, "KITTI points are 16 bytes");
   if (!points.empty()) std::memcpy(msg.data.data(), points.data(), msg.data.size());
 }
@@ -90,10 +71,10 @@ void KittiConversions::toLabelledCloud(const std::vector<dataset::KittiPoint>& p
 {
   if (labels.size() != points.size()) throw std::invalid_argument("toLabelledCloud: one label per point");
   header(msg, stamp, frame_id, points.size(), kLabelledPointStep);
-  msg.fields = { field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
-                 field("z", 8, sensor_msgs::PointField::FLOAT32),
-                 field("label", kLabelOffset, sensor_msgs::PointField::UINT32),
-                 field("state", kStateOffset, sensor_msgs::PointField::UINT8) };
+  msg.fields = { pointField("x", 0, sensor_msgs::PointField::FLOAT32), pointField("y", 4, sensor_msgs::PointField::FLOAT32),
+                 pointField("z", 8, sensor_msgs::PointField::FLOAT32),
+                 pointField("label", kLabelOffset, sensor_msgs::PointField::UINT32),
+                 pointField("state", kStateOffset, sensor_msgs::PointField::UINT8) };
   std::uint8_t* p = msg.data.data();
   for (std::size_t k = 0; k < points.size(); ++k, p += kLabelledPointStep)
   {
@@ -178,7 +159,7 @@ KittiBagStats writeKittiBag(const dataset::KittiSequence& sequence, const KittiB
     first.fromSec(o.start_stamp + sequence.time(0));
     tf2_msgs::TFMessage statics;
     statics.transforms.push_back(toTransform(lift, first, o.base_frame, o.lidar_frame));
-    bag.write("/tf_static", first, statics, latchedTfHeader());
+    bag.write("/tf_static", first, statics, latchedConnectionHeader<tf2_msgs::TFMessage>("/kitti_to_bag"));
     const Eigen::Isometry3d lift_inv = lift.inverse();
     for (std::size_t k = 0; k < sequence.size(); ++k)
     {

@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <ostream>
 
+#include "map_aided_fusion/ros/bag_writing.hpp"
 #include "map_aided_fusion/ros/conversions.hpp"
 
 namespace map_aided_fusion {
@@ -25,28 +26,6 @@ geometry_msgs::Quaternion yawQuaternion(double yaw)
   q.w = std::cos(0.5 * yaw);
   q.z = std::sin(0.5 * yaw);
   return q;
-}
-
-sensor_msgs::PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type)
-{
-  sensor_msgs::PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = type;
-  f.count = 1;
-  return f;
-}
-
-template <class M>
-boost::shared_ptr<ros::M_string> latchedHeader()
-{
-  auto h = boost::make_shared<ros::M_string>();
-  (*h)["type"] = ros::message_traits::datatype<M>();
-  (*h)["md5sum"] = ros::message_traits::md5sum<M>();
-  (*h)["message_definition"] = ros::message_traits::definition<M>();
-  (*h)["callerid"] = "/simulate";
-  (*h)["latching"] = "1";
-  return h;
 }
 
 }  // namespace
@@ -65,10 +44,10 @@ void SimConversions::toPointCloud2(const sim::ScanFrame& frame, const ros::Time&
   msg.header.frame_id = frame_id;
   msg.height = 1;
   msg.width = static_cast<std::uint32_t>(frame.points.size());
-  msg.fields = { field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
-                 field("z", 8, sensor_msgs::PointField::FLOAT32),
-                 field("intensity", 12, sensor_msgs::PointField::FLOAT32),
-                 field("ring", 16, sensor_msgs::PointField::UINT16) };
+  msg.fields = { pointField("x", 0, sensor_msgs::PointField::FLOAT32), pointField("y", 4, sensor_msgs::PointField::FLOAT32),
+                 pointField("z", 8, sensor_msgs::PointField::FLOAT32),
+                 pointField("intensity", 12, sensor_msgs::PointField::FLOAT32),
+                 pointField("ring", 16, sensor_msgs::PointField::UINT16) };
   msg.is_bigendian = false;
   msg.point_step = kPointStep;
   msg.row_step = kPointStep * msg.width;
@@ -141,7 +120,7 @@ SimBagStats writeSimulationBag(sim::Simulator& simulator, const SimBagOptions& o
   mount.transform.translation.z = sc.lidar.mount_z;
   mount.transform.rotation = yawQuaternion(sc.lidar.mount_yaw_deg * kDegToRad);
   statics.transforms.push_back(mount);
-  bag.write(n.tf_static_topic, mount.header.stamp, statics, latchedHeader<tf2_msgs::TFMessage>());
+  bag.write(n.tf_static_topic, mount.header.stamp, statics, latchedConnectionHeader<tf2_msgs::TFMessage>("/simulate"));
 
   const int scans = simulator.numScans();
   const double tf_period = 1.0 / sc.tf_rate_hz;

@@ -65,7 +65,6 @@ struct World
   std::vector<P3> sweep(const Pose2& pose, double azimuth_step_deg = 0.2) const
   {
     std::vector<P3> out;
-    const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
     for (double deg = -180.0; deg < 180.0; deg += azimuth_step_deg)
     {
       const double local = deg * M_PI / 180.0;
@@ -77,8 +76,6 @@ struct World
         for (double z = 0.5; z <= 1.5; z += 0.25)
           out.push_back({ static_cast<float>(r * lx), static_cast<float>(r * ly), static_cast<float>(z) });
     }
-    (void)c;
-    (void)s;
     return out;
   }
 };

@@ -290,6 +290,35 @@ TEST(ScanGrid, HeightBandsAndRanges)
   expectUnknown(grid, 40, 40);
 }
 
+TEST(ScanGrid, RelativeHeightDropsRaisedGroundAndKeepsObstaclesOnIt)
+{
+  std::vector<P> pts;
+  int pavement = 0;
+  for (float x = 8.0f; x <= 10.0f; x += 0.25f)  // a pavement 0.4 m above the vehicle's ground plane
+    for (float y = -1.0f; y <= 1.0f; y += 0.25f, ++pavement) pts.push_back({ x, y, 0.4f });
+  for (float x = 13.0f; x < 14.0f; x += 0.25f) pts.push_back({ x, 0.0f, 0.0f });  // road before a low box
+  for (float z = 0.3f; z <= 0.7f; z += 0.1f) pts.push_back({ 14.1f, 0.0f, z });    // its face, 0.3-0.7 m
+  pts.push_back({ 18.1f, 3.6f, 1.4f });                                          // a roof, no lower return around
+  ScanGridParams p = testParams();
+  p.relative_height_limit = 0.8;
+  ScanGridBuilder builder(p, Eigen::Isometry3d::Identity());
+  ScanMassGrid grid;
+  ScanGridStats st;
+  ASSERT_TRUE(builder.build(view(pts), grid, &st));
+  EXPECT_EQ(st.low_relief, static_cast<std::size_t>(pavement));
+  EXPECT_EQ(st.occupied_cells, 2u);  // the box and the roof
+  for (int x = 56; x <= 60; ++x) EXPECT_EQ(at(grid, x, 40).o, 0.0f) << x;
+  expectOccupied(grid, 68, 40);
+  expectOccupied(grid, 76, 47);
+  EXPECT_EQ(builder.obstaclePoints().count, st.obstacle);
+
+  p.relative_height_limit = 0.0;  // the paper's flat rule: the pavement is an obstacle
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pts), grid, &st));
+  EXPECT_EQ(st.low_relief, 0u);
+  for (int x = 56; x <= 60; ++x) expectOccupied(grid, x, 40);
+}
+
 TEST(ScanGrid, SelfFilterDropsTheVehiclesOwnReturns)
 {
   ScanGridParams p = testParams();

@@ -68,8 +68,8 @@ struct MapGridParams
   /**
    * Step "motion spreading" (not in the paper): after the step, each connected region (8-connectivity) of cells
    * the scan sees occupied, of at most motion_max_cells cells, in which at least this share of cells has
-   * BetP(V) ≥ decision_threshold and BetP(V) − BetP(S) > motion_margin, is one moving object: in each of its cells the occupied mass that still leaves
-   * the motion open (focal sets holding V and other classes) goes to {V}. Conflict only marks the cells an object
+   * BetP(V) ≥ decision_threshold and BetP(V) − BetP(S) > motion_margin, is one moving object: in each of its cells
+   * the occupied mass that still leaves the motion open (focal sets holding V and other classes) goes to {V}. Conflict only marks the cells an object
    * enters; the rest of a mover (the cells it still covers, and all of it when it moves away from the sensor) would
    * otherwise stay undecided. In [0, 1]; 0 disables it.
    */
