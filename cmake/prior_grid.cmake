@@ -20,7 +20,7 @@ install(TARGETS map_aided_fusion_map_io
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # ---- Core: scanline rasteriser and PriorGrid (ROS-free) ---------------------------------------
-target_sources(map_aided_fusion_core PRIVATE src/core/prior_grid.cpp)
+target_sources(map_aided_fusion_core PRIVATE src/core/prior_grid.cpp src/core/prior_uncertainty.cpp)
 
 # ---- ROS: nodelet (library name fixed by nodelet_plugins.xml) and plain node -------------------------
 add_library(map_aided_fusion_prior_grid_nodelet
@@ -40,7 +40,7 @@ install(TARGETS map_aided_fusion_prior_grid_nodelet prior_grid_node
 
 # ---- Tests --------------------------------------------------------------------------------------
 if(CATKIN_ENABLE_TESTING)
-  catkin_add_gtest(test_prior_grid test/prior/test_prior_grid.cpp test/test_main.cpp)
+  catkin_add_gtest(test_prior_grid test/prior/test_prior_grid.cpp test/prior/test_prior_uncertainty.cpp test/test_main.cpp)
   target_link_libraries(test_prior_grid map_aided_fusion_core)
 
   catkin_add_gtest(test_map_loader test/prior/test_map_loader.cpp test/prior/test_reader_faults.cpp test/test_main.cpp)

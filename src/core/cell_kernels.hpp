@@ -108,7 +108,7 @@ MAF_INLINE void forEachCell(std::size_t n, const float* base, std::size_t stride
   for (; i < n; ++i) body(float{}, i);
 }
 
-/// The eight focal sets r(m_SG) ⊕ m_PG can have: intersections of {F, O, Ω} with {B, R, T, Ω}.
+/// The nine focal sets r(m_SG) ⊕ m_PG can have: intersections of {F, O, Ω} with {B, R, T, W, Ω}.
 enum ScanPriorIndex
 {
   kSpF,
@@ -119,11 +119,13 @@ enum ScanPriorIndex
   kSpFSV,
   kSpFNSV,
   kSpOmega,
+  kSpFC,
   kNumScanPrior
 };
 constexpr std::array<Subset, kNumScanPrior> kScanPriorSets{
   FrameMG::kF,           FrameMG::kC,      FrameMG::kS | FrameMG::kV, FrameMG::kN | FrameMG::kS | FrameMG::kV,
-  FrameMG::kO,           FrameMG::kRoad,   FrameMG::kOther,           FrameMG::kOmega
+  FrameMG::kO,           FrameMG::kRoad,   FrameMG::kOther,           FrameMG::kOmega,
+  FrameMG::kWall
 };
 
 constexpr std::array<int, kSubsets> makeOpenTable()
@@ -188,21 +190,23 @@ MAF_INLINE void contextualDiscount(T (&m)[kSubsets], const Weights& w)
 }
 
 /**
- * r(m_SG) ⊕ m_PG in the eight sets of kScanPriorSets, from m_SG(F), m_SG(O), m_SG(Ω) and the prior
- * masses m_PG(B), m_PG(R), m_PG(T). Total conflict gives the vacuous mass function. Returns the
+ * r(m_SG) ⊕ m_PG in the nine sets of kScanPriorSets, from m_SG(F), m_SG(O), m_SG(Ω) and the prior
+ * masses m_PG(B), m_PG(R), m_PG(T), m_PG(W). Total conflict gives the vacuous mass function. Returns the
  * Dempster conflict K.
  */
 template <typename T>
-MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T (&sp)[kNumScanPrior], float total_conflict_threshold)
+MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T pw, T (&sp)[kNumScanPrior],
+                           float total_conflict_threshold)
 {
   const T one = splat<T>(1.0f), zero = T{};
-  const T pomega = one - pb - pr - pt;
+  const T pomega = one - pb - pr - pt - pw;
   const T k = pb * sf;
   const T norm = one - k;
   const auto total = norm < total_conflict_threshold;
   const T inv = select(total, zero, one / norm);
-  sp[kSpF] = sf * (pr + pt + pomega) * inv;
-  sp[kSpC] = pb * (so + somega) * inv;
+  sp[kSpF] = sf * (pr + pt + pw + pomega) * inv;
+  sp[kSpC] = (pb * (so + somega) + pw * so) * inv;
+  sp[kSpFC] = pw * somega * inv;
   sp[kSpSV] = pr * so * inv;
   sp[kSpNSV] = pt * so * inv;
   sp[kSpCNSV] = pomega * so * inv;
@@ -259,9 +263,9 @@ MAF_INLINE void accumulateOn(const T (&g)[kSubsets], T w, T (&c)[kSubsets])
 /**
  * c = m ∩ sp (unnormalised, c[∅] is the conflict) for sp in the sets of kScanPriorSets, through the
  * marginals of m on each focal set S_k: (m ∩ sp)(A) = Σ_k sp_k · Σ_{X ∩ S_k = A} m(X). The marginals
- * are built one dropped element at a time and shared between nested sets.
+ * are built one dropped element at a time and shared between nested sets. kWall: sp may hold mass on W.
  */
-template <typename T>
+template <bool kWall, typename T>
 MAF_INLINE void conjunctiveWithScanPrior(const T (&m)[kSubsets], const T (&sp)[kNumScanPrior], T (&c)[kSubsets])
 {
   constexpr int F = FrameMG::kF, C = FrameMG::kC, N = FrameMG::kN, S = FrameMG::kS, V = FrameMG::kV;
@@ -287,16 +291,24 @@ MAF_INLINE void conjunctiveWithScanPrior(const T (&m)[kSubsets], const T (&sp)[k
   dropElement<C | S | V, S>(csv, cv);
   dropElement<C | V, V>(cv, cc);
   accumulateOn<C>(cc, sp[kSpC], c);
+  if (kWall)
+  {
+    T fcsv[kSubsets], fcv[kSubsets], fc[kSubsets];
+    dropElement<W, N>(m, fcsv);
+    dropElement<F | C | S | V, S>(fcsv, fcv);
+    dropElement<F | C | V, V>(fcv, fc);
+    accumulateOn<F | C>(fc, sp[kSpFC], c);
+  }
 }
 
 /**
  * m ← m ⊛ sp (sp in the sets of kScanPriorSets), the modified Yager rule; returns the conflicts.
  */
-template <typename T>
+template <bool kWall, typename T>
 MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumScanPrior], int rule = 0)
 {
   T c[kSubsets];
-  conjunctiveWithScanPrior(m, sp, c);
+  conjunctiveWithScanPrior<kWall>(m, sp, c);
   T map_occupied = T{};
   MAF_UNROLL
   for (int a = 1; a < kSubsets; ++a)

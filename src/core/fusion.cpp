@@ -55,6 +55,7 @@ struct StepInputs
   const float* pb;
   const float* pr;
   const float* pt;
+  const float* pw;
   float delta_inc, delta_dec, gamma_occupied, gamma_conflict, threshold;
   bool literal;
   int rule;
@@ -67,7 +68,7 @@ struct StepInputs
 
 /// kPaper: the paper's method (⊛, contextual discounting, counter) compiled without the ablation branches,
 /// which costs about a fifth of the time; otherwise the options are read at run time.
-template <bool kHasPrior, bool kPaper>
+template <bool kHasPrior, bool kPaper, bool kWall>
 MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights<float>& w, FusionStepStats& stats)
 {
   float* __restrict base = in.base;
@@ -85,12 +86,13 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     const T zero{};
     kernels::scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i),
                            kHasPrior ? load<T>(in.pb + i) : zero, kHasPrior ? load<T>(in.pr + i) : zero,
-                           kHasPrior ? load<T>(in.pt + i) : zero, sp, in.threshold);
+                           kHasPrior ? load<T>(in.pt + i) : zero, kWall ? load<T>(in.pw + i) : zero, sp,
+                           in.threshold);
     if (kPaper || in.contextual)
       kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
     else
       kernels::classicalDiscount(m, in.alpha_single);
-    const auto c = kernels::modifiedYager(m, sp, kPaper ? kernels::kRuleModifiedYager : in.rule);
+    const auto c = kernels::modifiedYager<kWall>(m, sp, kPaper ? kernels::kRuleModifiedYager : in.rule);
     if (kPaper || in.use_counter)
     {
       const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m),
@@ -142,6 +144,7 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   in.pb = prior ? prior->building.data() : nullptr;
   in.pr = prior ? prior->road.data() : nullptr;
   in.pt = prior ? prior->other.data() : nullptr;
+  in.pw = prior ? prior->wall.data() : nullptr;
   in.delta_inc = static_cast<float>(params.counter.delta_inc);
   in.delta_dec = static_cast<float>(params.counter.delta_dec);
   in.gamma_occupied = static_cast<float>(params.counter.gamma_occupied);
@@ -162,10 +165,12 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   }
   FusionStepStats local;
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
-  if (prior)
-    paper ? fusionLoop<true, true>(in, w, local) : fusionLoop<true, false>(in, w, local);
+  if (prior && prior->hasWall())
+    paper ? fusionLoop<true, true, true>(in, w, local) : fusionLoop<true, false, true>(in, w, local);
+  else if (prior)
+    paper ? fusionLoop<true, true, false>(in, w, local) : fusionLoop<true, false, false>(in, w, local);
   else
-    paper ? fusionLoop<false, true>(in, w, local) : fusionLoop<false, false>(in, w, local);
+    paper ? fusionLoop<false, true, false>(in, w, local) : fusionLoop<false, false, false>(in, w, local);
   if (stats) *stats = local;
 }
 

@@ -50,6 +50,7 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
   const float* __restrict pb = prior.building.data();
   const float* __restrict pr = prior.road.data();
   const float* __restrict pt = prior.other.data();
+  const float* __restrict pw = prior.wall.data();
   const float threshold = static_cast<float>(kTotalConflictThreshold);
   kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
@@ -57,9 +58,9 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
     T m[kSubsets];
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) m[a] = load<T>(base + a * stride + i);
-    const T b = load<T>(pb + i), r = load<T>(pr + i), t = load<T>(pt + i);
+    const T b = load<T>(pb + i), r = load<T>(pr + i), t = load<T>(pt + i), wl = load<T>(pw + i);
     const T one = kernels::splat<T>(1.0f), zero{};
-    const T u = one - b - r - t;
+    const T u = one - b - r - t - wl;
     T c[kSubsets];
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) c[a] = u * m[a];
@@ -69,6 +70,7 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
       c[a & FrameMG::kBuilding] += b * m[a];
       c[a & FrameMG::kRoad] += r * m[a];
       c[a & FrameMG::kOther] += t * m[a];
+      c[a & FrameMG::kWall] += wl * m[a];
     }
     const T norm = one - c[0];
     const auto total = norm < threshold;

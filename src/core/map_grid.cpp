@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "cell_kernels.hpp"
 
 namespace map_aided_fusion {
@@ -72,6 +73,8 @@ void MapGridParams::validate() const
   requireInRange("obstacle_clearance", obstacle_clearance, 0.0, kMaxObstacleClearance);
   requireUnit("motion_share", motion_share);
   requireUnit("motion_margin", motion_margin);
+  requireUnit("map_conflict_gain", map_conflict_gain);
+  requireInRange("position_sigma", position_sigma, 0.0, kMaxPositionSigma);
   if (motion_max_cells < 1) throw ParameterError("motion_max_cells", "must be at least 1");
   if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
   fusion.validate();
@@ -82,7 +85,8 @@ std::size_t MapGridParams::bytesPerCell()
   const std::size_t planes = (FrameMG::kNumSubsets + 1)   // masses and ζ
                              + FrameMG::kSize              // BetP
                              + FrameSG::kNumSubsets        // the scan projected into the window
-                             + 3;                          // the prior window (building, road, other)
+                             + 4                           // the prior window (building, road, other, wall)
+                             + 1;                          // the map doubt η
   return planes * sizeof(float) + sizeof(std::int8_t);     // and the decision
 }
 
@@ -220,7 +224,7 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
 
 void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out)
 {
-  if (out.building.size() != window.numCells())
+  if (out.building.size() != window.numCells() || out.wall.size() != window.numCells())
     out.reset(window);
   out.geometry = window;
   std::vector<int> column(static_cast<std::size_t>(window.width));
@@ -241,13 +245,14 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
       const int px = column[static_cast<std::size_t>(x)];
       if (!row_inside || px < 0)
       {
-        out.building[j] = out.road[j] = out.other[j] = 0.0f;
+        out.building[j] = out.road[j] = out.other[j] = out.wall[j] = 0.0f;
         continue;
       }
       const std::size_t i = prior.geometry.index(px, static_cast<int>(fy));
       out.building[j] = prior.building[i];
       out.road[j] = prior.road[i];
       out.other[j] = prior.other[i];
+      out.wall[j] = prior.wall[i];
     }
   }
 }
@@ -453,6 +458,7 @@ void MapGrid::setParams(const MapGridParams& params)
   if (realloc)
   {
     grid_.reset(g);
+    map_doubt_.assign(g.numCells(), 0.0f);
     pignisticGrid(grid_, betp_);
     scans_ = 0;
   }
@@ -461,10 +467,39 @@ void MapGrid::setParams(const MapGridParams& params)
 void MapGrid::reset()
 {
   grid_.fillVacuous();
+  std::fill(map_doubt_.begin(), map_doubt_.end(), 0.0f);
   pignisticGrid(grid_, betp_);
   scans_ = 0;
   last_stamp_ = 0.0;
 }
+
+namespace {
+
+/// Moves one plane of a @p g-sized window by whole cells (see MapGrid::shift), filling vacated cells with @p fill.
+void shiftPlane(float* p, const GridGeometry& g, int dx, int dy, float fill)
+{
+  const std::size_t w = static_cast<std::size_t>(g.width);
+  const int x0 = std::max(0, -dx), x1 = std::min(g.width, g.width - dx);
+  const std::size_t count = static_cast<std::size_t>(x1 - x0);
+  const bool forward = dy > 0 || (dy == 0 && dx > 0);
+  for (int k = 0; k < g.height; ++k)
+  {
+    const int y = forward ? k : g.height - 1 - k;
+    float* row = p + static_cast<std::size_t>(y) * w;
+    const int sy = y + dy;
+    if (sy < 0 || sy >= g.height)
+    {
+      std::fill(row, row + w, fill);
+      continue;
+    }
+    const float* src = p + static_cast<std::size_t>(sy) * w;
+    std::memmove(row + x0, src + x0 + dx, count * sizeof(float));
+    std::fill(row, row + x0, fill);
+    std::fill(row + x1, row + w, fill);
+  }
+}
+
+}  // namespace
 
 void MapGrid::shift(int dx, int dy)
 {
@@ -474,31 +509,35 @@ void MapGrid::shift(int dx, int dy)
   if (std::abs(dx) >= g.width || std::abs(dy) >= g.height)
   {
     grid_.fillVacuous();
+    std::fill(map_doubt_.begin(), map_doubt_.end(), 0.0f);
     return;
   }
-  const std::size_t w = static_cast<std::size_t>(g.width);
-  const int x0 = std::max(0, -dx), x1 = std::min(g.width, g.width - dx);
-  const std::size_t count = static_cast<std::size_t>(x1 - x0);
-  const bool forward = dy > 0 || (dy == 0 && dx > 0);
   for (int plane = 0; plane <= FrameMG::kNumSubsets; ++plane)
   {
     float* p = plane == FrameMG::kNumSubsets ? grid_.counter() : grid_.plane(static_cast<Subset>(plane));
-    const float fill = plane == FrameMG::kOmega ? 1.0f : 0.0f;
-    for (int k = 0; k < g.height; ++k)
-    {
-      const int y = forward ? k : g.height - 1 - k;
-      float* row = p + static_cast<std::size_t>(y) * w;
-      const int sy = y + dy;
-      if (sy < 0 || sy >= g.height)
-      {
-        std::fill(row, row + w, fill);
-        continue;
-      }
-      const float* src = p + static_cast<std::size_t>(sy) * w;
-      std::memmove(row + x0, src + x0 + dx, count * sizeof(float));
-      std::fill(row, row + x0, fill);
-      std::fill(row + x1, row + w, fill);
-    }
+    shiftPlane(p, g, dx, dy, plane == FrameMG::kOmega ? 1.0f : 0.0f);
+  }
+  if (map_doubt_.size() == g.numCells()) shiftPlane(map_doubt_.data(), g, dx, dy, 0.0f);
+}
+
+void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt)
+{
+  const std::size_t n = prior.geometry.numCells();
+  if (doubt.size() != n) doubt.assign(n, 0.0f);
+  const float g = static_cast<float>(gain);
+  const float* sf = scan.plane(FrameSG::kF);
+  const float* so = scan.plane(FrameSG::kO);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const float k = prior.building[i] * sf[i];
+    const float a = (prior.building[i] + prior.wall[i]) * so[i];
+    const float eta = std::clamp(doubt[i] + g * (k - a), 0.0f, 1.0f);
+    doubt[i] = eta;
+    const float keep = 1.0f - eta;
+    prior.building[i] *= keep;
+    prior.road[i] *= keep;
+    prior.other[i] *= keep;
+    prior.wall[i] *= keep;
   }
 }
 
@@ -537,7 +576,11 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   t.project_scan = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  if (prior) extractPriorWindow(*prior, grid_.geometry(), prior_window_);
+  if (prior)
+  {
+    extractPriorWindow(*prior, grid_.geometry(), prior_window_);
+    if (params_.map_conflict_gain > 0.0) applyMapConflict(prior_window_, scan_window_, params_.map_conflict_gain, map_doubt_);
+  }
   t.prior_window = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();

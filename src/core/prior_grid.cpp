@@ -145,6 +145,23 @@ void bufferRoadLine(const RoadLine& line, std::vector<Ring>& out)
 // PriorGrid
 // ------------------------------------------------------------------------------------------------
 
+namespace {
+
+bool validPolygon(const Polygon& p)
+{
+  if (p.outer.size() < 3 || !finiteRing(p.outer)) return false;
+  return std::all_of(p.holes.begin(), p.holes.end(), finiteRing);
+}
+
+constexpr std::uint16_t kAllSamples = static_cast<std::uint16_t>((1u << kCoverageSamples) - 1u);
+
+int samplesIn(std::uint16_t bits)
+{
+  return __builtin_popcount(static_cast<unsigned>(bits));
+}
+
+}  // namespace
+
 PriorGrid::PriorGrid(const GridGeometry& geometry) : geometry_(geometry)
 {
   geometry.validate();
@@ -187,17 +204,34 @@ GridGeometry PriorGrid::extentOf(const VectorMap& map, double resolution, double
   return g;
 }
 
-PriorGrid PriorGrid::fromVectorMap(const VectorMap& map, double resolution, double margin, PriorBuildStats* stats)
+const char* toString(PriorCellTest t)
+{
+  return t == PriorCellTest::kCoverage ? "coverage" : "centre";
+}
+
+PriorCellTest parsePriorCellTest(const std::string& s)
+{
+  if (s == "centre") return PriorCellTest::kCentre;
+  if (s == "coverage") return PriorCellTest::kCoverage;
+  throw ParameterError("cell_test", "must be 'centre' or 'coverage', not '" + s + "'");
+}
+
+PriorGrid PriorGrid::fromVectorMap(const VectorMap& map, double resolution, double margin, PriorBuildStats* stats,
+                                   PriorCellTest test)
 {
   PriorGrid grid;
-  grid.build(map, extentOf(map, resolution, margin), stats);
+  grid.build(map, extentOf(map, resolution, margin), stats, test);
   return grid;
 }
 
-void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorBuildStats* stats)
+void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorBuildStats* stats, PriorCellTest test)
 {
   geometry.validate();
   geometry_ = geometry;
+  test_ = test;
+  building_samples_.clear();
+  road_samples_.clear();
+  outline_.clear();
   labels_.assign(geometry.numCells(), PriorClass::kOther);
   PriorBuildStats local;
   PriorBuildStats& st = stats != nullptr ? *stats : local;
@@ -218,10 +252,6 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
     const auto [ymin, ymax] = std::minmax_element(r.begin(), r.end(), [](auto& a, auto& b) { return a.y < b.y; });
     return xmax->x >= geometry_.origin_x && xmin->x <= geometry_.origin_x + geometry_.sizeX() &&
            ymax->y >= geometry_.origin_y && ymin->y <= geometry_.origin_y + geometry_.sizeY();
-  };
-  const auto validPolygon = [](const Polygon& p) {
-    if (p.outer.size() < 3 || !finiteRing(p.outer)) return false;
-    return std::all_of(p.holes.begin(), p.holes.end(), finiteRing);
   };
 
   for (const Polygon& area : map.road_areas)
@@ -267,6 +297,124 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
     else
       ++st.buildings_outside;
   }
+  if (test == PriorCellTest::kCoverage) sampleCoverage(map, st);
+}
+
+
+void PriorGrid::sampleCoverage(const VectorMap& map, PriorBuildStats& st)
+{
+  constexpr int k = kCoverageSamplesPerSide;
+  static_assert(kCoverageSamples <= 16, "one bit per sample in a uint16_t");
+  if (geometry_.width > std::numeric_limits<int>::max() / k || geometry_.height > std::numeric_limits<int>::max() / k)
+    throw ParameterError("cell_test", "the grid is too large for the coverage test");
+  const std::size_t n = geometry_.numCells();
+  building_samples_.assign(n, 0);
+  road_samples_.assign(n, 0);
+  outline_.assign(n, 0);
+  GridGeometry fine = geometry_;
+  fine.resolution = geometry_.resolution / k;
+  fine.width = geometry_.width * k;
+  fine.height = geometry_.height * k;
+  ScanlineRasterizer rasterizer(fine);
+  std::vector<CellSpan> spans;
+  const auto mark = [&](std::vector<std::uint16_t>& bits) {
+    for (const CellSpan& sp : spans)
+    {
+      std::uint16_t* row = bits.data() + geometry_.index(0, sp.row / k);
+      const unsigned shift = static_cast<unsigned>((sp.row % k) * k);
+      for (int c = sp.col_begin; c < sp.col_end; ++c) row[c / k] |= static_cast<std::uint16_t>(1u << (shift + c % k));
+    }
+  };
+  for (const Polygon& area : map.road_areas)
+    if (validPolygon(area))
+    {
+      rasterizer.fill(area, spans);
+      mark(road_samples_);
+    }
+  std::vector<Ring> pieces;
+  for (const RoadLine& line : map.road_lines)
+  {
+    if (!(line.width > 0.0) || !std::isfinite(line.width) || line.points.size() < 2 || !finiteRing(line.points)) continue;
+    pieces.clear();
+    bufferRoadLine(line, pieces);
+    for (const Ring& piece : pieces)
+    {
+      rasterizer.fill(piece, spans);
+      mark(road_samples_);
+    }
+  }
+  const auto traceRing = [&](const Ring& ring) {
+    for (std::size_t i = 0; i < ring.size(); ++i)
+    {
+      const Point2 a = ring[i], b = ring[(i + 1) % ring.size()];
+      const double len = std::hypot(b.x - a.x, b.y - a.y);
+      if (!(len > 0.0)) continue;
+      traverseCells(geometry_, a, (b.x - a.x) / len, (b.y - a.y) / len, len, [&](std::size_t c) { outline_[c] = 1; });
+    }
+  };
+  for (const Building& b : map.buildings)
+  {
+    if (!validPolygon(b.footprint)) continue;
+    rasterizer.fill(b.footprint, spans);
+    mark(building_samples_);
+    traceRing(b.footprint.outer);
+    for (const Ring& h : b.footprint.holes) traceRing(h);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (outline_[i] && building_samples_[i] == kAllSamples) outline_[i] = 0;
+    if (!outline_[i]) continue;
+    labels_[i] = PriorClass::kBuilding;
+    ++st.outline_cells;
+  }
+}
+
+double PriorGrid::buildingCoverage(CellIndex c) const
+{
+  if (building_samples_.empty() || !geometry_.contains(c)) return 0.0;
+  return samplesIn(building_samples_[geometry_.index(c)]) / double(kCoverageSamples);
+}
+
+double PriorGrid::roadCoverage(CellIndex c) const
+{
+  if (road_samples_.empty() || !geometry_.contains(c)) return 0.0;
+  const std::size_t i = geometry_.index(c);
+  return samplesIn(static_cast<std::uint16_t>(road_samples_[i] & ~building_samples_[i])) / double(kCoverageSamples);
+}
+
+bool PriorGrid::outline(CellIndex c) const
+{
+  return !outline_.empty() && geometry_.contains(c) && outline_[geometry_.index(c)] != 0;
+}
+
+void PriorGrid::cellMasses(std::size_t i, const PriorConfidence& beta, float& building, float& road, float& other,
+                           float& wall) const
+{
+  building = road = other = wall = 0.0f;
+  const PriorClass label = labels_[i];
+  if (label == PriorClass::kUnknown) return;
+  if (outline_.empty())
+  {
+    const float b = static_cast<float>(beta.beta(label));
+    (label == PriorClass::kBuilding ? building : label == PriorClass::kRoad ? road : other) = b;
+    return;
+  }
+  if (outline_[i])
+  {
+    wall = static_cast<float>(beta.beta_building);
+    return;
+  }
+  const int nb = samplesIn(building_samples_[i]);
+  const int nr = samplesIn(static_cast<std::uint16_t>(road_samples_[i] & ~building_samples_[i]));
+  constexpr double kInv = 1.0 / kCoverageSamples;
+  building = static_cast<float>(beta.beta_building * nb * kInv);
+  road = static_cast<float>(beta.beta_road * nr * kInv);
+  other = static_cast<float>(beta.beta_other * (kCoverageSamples - nb - nr) * kInv);
+}
+
+bool PriorWindow::hasWall() const
+{
+  return std::any_of(wall.begin(), wall.end(), [](float v) { return v != 0.0f; });
 }
 
 PriorClass PriorGrid::labelAt(Point2 p) const
@@ -301,7 +449,8 @@ bool wholeCellOffset(const GridGeometry& a, const GridGeometry& b, long& dx, lon
 
 void PriorGrid::fillWindow(const GridGeometry& window, const PriorConfidence& beta, PriorWindow& out) const
 {
-  if (out.geometry != window || out.building.size() != window.numCells()) out.reset(window);
+  if (out.geometry != window || out.building.size() != window.numCells() || out.wall.size() != window.numCells())
+    out.reset(window);
   std::array<float, kNumPriorClasses> mb{}, mr{}, mt{};
   mb[static_cast<int>(PriorClass::kBuilding)] = static_cast<float>(beta.beta_building);
   mr[static_cast<int>(PriorClass::kRoad)] = static_cast<float>(beta.beta_road);
@@ -309,11 +458,20 @@ void PriorGrid::fillWindow(const GridGeometry& window, const PriorConfidence& be
   float* ob = out.building.data();
   float* orr = out.road.data();
   float* ot = out.other.data();
-  const auto put = [&](std::size_t i, PriorClass v) {
-    const auto k = static_cast<std::size_t>(v);
+  float* ow = out.wall.data();
+  const bool coverage = !outline_.empty();
+  const auto vacuous = [&](std::size_t i) { ob[i] = orr[i] = ot[i] = ow[i] = 0.0f; };
+  const auto put = [&](std::size_t i, std::size_t j) {
+    if (coverage)
+    {
+      cellMasses(j, beta, ob[i], orr[i], ot[i], ow[i]);
+      return;
+    }
+    const auto k = static_cast<std::size_t>(labels_[j]);
     ob[i] = mb[k];
     orr[i] = mr[k];
     ot[i] = mt[k];
+    ow[i] = 0.0f;
   };
 
   long dx = 0, dy = 0;
@@ -330,19 +488,26 @@ void PriorGrid::fillWindow(const GridGeometry& window, const PriorConfidence& be
         c1 = std::min(static_cast<long>(window.width), static_cast<long>(geometry_.width) - dx);
         c1 = std::max(c0, c1);
       }
-      for (long c = 0; c < c0; ++c) put(base + c, PriorClass::kUnknown);
+      for (long c = 0; c < c0; ++c) vacuous(base + c);
       if (c1 > c0)
       {
-        const PriorClass* src = labels_.data() + geometry_.index(static_cast<int>(c0 + dx), static_cast<int>(sr));
-        for (long c = c0; c < c1; ++c) put(base + c, src[c - c0]);
+        const std::size_t src = geometry_.index(static_cast<int>(c0 + dx), static_cast<int>(sr));
+        for (long c = c0; c < c1; ++c) put(base + c, src + static_cast<std::size_t>(c - c0));
       }
-      for (long c = c1; c < window.width; ++c) put(base + c, PriorClass::kUnknown);
+      for (long c = c1; c < window.width; ++c) vacuous(base + c);
     }
     return;
   }
   for (int r = 0; r < window.height; ++r)
     for (int c = 0; c < window.width; ++c)
-      put(window.index(c, r), labelAt(window.cellCentre(CellIndex{ c, r })));
+    {
+      CellIndex src;
+      const std::size_t i = window.index(c, r);
+      if (!labels_.empty() && geometry_.worldToCell(window.cellCentre(CellIndex{ c, r }), src))
+        put(i, geometry_.index(src));
+      else
+        vacuous(i);
+    }
 }
 
 PriorGrid PriorGrid::crop(const GridGeometry& window) const
@@ -352,6 +517,13 @@ PriorGrid PriorGrid::crop(const GridGeometry& window) const
   if (!wholeCellOffset(geometry_, window, dx, dy))
     throw ParameterError("window", "crop needs the same resolution and a whole-cell origin offset");
   PriorGrid out(window);
+  out.test_ = test_;
+  if (!outline_.empty())
+  {
+    out.building_samples_.assign(window.numCells(), 0);
+    out.road_samples_.assign(window.numCells(), 0);
+    out.outline_.assign(window.numCells(), 0);
+  }
   for (int r = 0; r < window.height; ++r)
   {
     const long sr = r + dy;
@@ -359,8 +531,15 @@ PriorGrid PriorGrid::crop(const GridGeometry& window) const
     const long c0 = std::max(0L, -dx);
     const long c1 = std::min(static_cast<long>(window.width), static_cast<long>(geometry_.width) - dx);
     if (c1 <= c0) continue;
-    const PriorClass* src = labels_.data() + geometry_.index(static_cast<int>(c0 + dx), static_cast<int>(sr));
-    std::copy(src, src + (c1 - c0), out.labels_.data() + window.index(static_cast<int>(c0), r));
+    const std::size_t src = geometry_.index(static_cast<int>(c0 + dx), static_cast<int>(sr));
+    const std::size_t dst = window.index(static_cast<int>(c0), r);
+    std::copy_n(labels_.begin() + static_cast<std::ptrdiff_t>(src), c1 - c0, out.labels_.begin() + static_cast<std::ptrdiff_t>(dst));
+    if (outline_.empty()) continue;
+    std::copy_n(building_samples_.begin() + static_cast<std::ptrdiff_t>(src), c1 - c0,
+                out.building_samples_.begin() + static_cast<std::ptrdiff_t>(dst));
+    std::copy_n(road_samples_.begin() + static_cast<std::ptrdiff_t>(src), c1 - c0,
+                out.road_samples_.begin() + static_cast<std::ptrdiff_t>(dst));
+    std::copy_n(outline_.begin() + static_cast<std::ptrdiff_t>(src), c1 - c0, out.outline_.begin() + static_cast<std::ptrdiff_t>(dst));
   }
   return out;
 }

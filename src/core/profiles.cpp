@@ -6,6 +6,15 @@ namespace core {
 const std::vector<AddedStep>& addedSteps()
 {
   static const std::vector<AddedStep> steps{
+    { "cell_coverage", "the prior from the share of each cell covered by buildings and roads; outline cells are {F, C}",
+      [](const Profile& p) { return p.prior.cell_test == PriorCellTest::kCoverage; },
+      [](Profile& p) { p.prior.cell_test = PriorCellTest::kCentre; } },
+    { "map_accuracy", "the prior softened by the map's positional accuracy (building_accuracy, road_accuracy)",
+      [](const Profile& p) { return p.prior.building_accuracy > 0.0 || p.prior.road_accuracy > 0.0; },
+      [](Profile& p) { p.prior.building_accuracy = p.prior.road_accuracy = 0.0; } },
+    { "map_conflict", "a per-cell doubt about the map, grown where the scan sees through a mapped building, discounts the prior",
+      [](const Profile& p) { return p.map_grid.map_conflict_gain > 0.0; },
+      [](Profile& p) { p.map_grid.map_conflict_gain = 0.0; } },
     { "relative_height", "a low obstacle return must stand obstacle_min_height above the lowest return around it",
       [](const Profile& p) { return p.scan_grid.relative_height_limit > 0.0; },
       [](Profile& p) { p.scan_grid.relative_height_limit = 0.0; } },

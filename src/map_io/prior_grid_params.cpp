@@ -12,6 +12,7 @@ void PriorGridParams::validate() const
 {
   map.validate();
   beta.validate();
+  options.validate();
   if (frame_id.empty()) throw core::ParameterError("frame_id", "must not be empty");
   core::requirePositive("resolution", resolution);
   if (!std::isfinite(margin) || margin < 0.0) throw core::ParameterError("margin", "must be finite and >= 0");

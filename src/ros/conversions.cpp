@@ -162,9 +162,11 @@ void GridConversions::fromMessage(const EvidentialGrid& msg, core::PriorWindow& 
       std::copy_n(first, n, prior.road.begin());
     else if (a == FrameMG::kOther)
       std::copy_n(first, n, prior.other.begin());
+    else if (a == FrameMG::kWall)
+      std::copy_n(first, n, prior.wall.begin());
     else if (a != FrameMG::kOmega && a != FrameMG::kEmpty && std::any_of(first, first + n, [](float v) { return v != 0.0f; }))
       throw ConversionError("EvidentialGrid: a prior grid cannot carry mass on " + core::subsetName<FrameMG>(a) +
-                            " (only B, R, T and Omega)");
+                            " (only B, R, T, W = {F, C} and Omega)");
   }
 }
 
@@ -175,13 +177,17 @@ void GridConversions::toMessage(const core::PriorWindow& prior, const std_msgs::
   toMapMetaData(prior.geometry, msg.info);
   msg.info.map_load_time = header.stamp;
   msg.classes.assign(FrameMG::kNames.begin(), FrameMG::kNames.end());
+  const bool wall = prior.hasWall();
   msg.focal_sets = { FrameMG::kBuilding, FrameMG::kRoad, FrameMG::kOther, FrameMG::kOmega };
-  msg.masses.resize(4 * n);
+  if (wall) msg.focal_sets.push_back(FrameMG::kWall);
+  msg.masses.resize(msg.focal_sets.size() * n);
   auto out = msg.masses.begin();
   out = std::copy(prior.building.begin(), prior.building.end(), out);
   out = std::copy(prior.road.begin(), prior.road.end(), out);
   out = std::copy(prior.other.begin(), prior.other.end(), out);
-  for (std::size_t i = 0; i < n; ++i) *out++ = 1.0f - prior.building[i] - prior.road[i] - prior.other[i];
+  for (std::size_t i = 0; i < n; ++i)
+    *out++ = 1.0f - prior.building[i] - prior.road[i] - prior.other[i] - (wall ? prior.wall[i] : 0.0f);
+  if (wall) std::copy(prior.wall.begin(), prior.wall.end(), out);
   msg.counter.clear();
 }
 

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
+#include <nav_msgs/Odometry.h>
 #include <tf2/utils.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -47,6 +49,8 @@ void FusionNodeParams::validate() const
   core::requireInRange("tf_queue_size", tf_queue_size, 1, kMaxQueueSize);
   core::requireInRange("future_tolerance", future_tolerance, 0.0, kMaxFutureTolerance);
   core::requireInRange("object_box_height", object_box_height, 1e-3, kMaxObjectBoxHeight);
+  if (pose_covariance_type != "pose" && pose_covariance_type != "odometry")
+    throw core::ParameterError("pose_covariance_type", "must be 'pose' or 'odometry', not '" + pose_covariance_type + "'");
   time.validate();
   health.validate();
 }
@@ -60,6 +64,8 @@ FusionNodeParams FusionNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "future_tolerance", p.future_tolerance);
   readParam(pnh, "publish_free_cells", p.publish_free_cells);
   readParam(pnh, "object_box_height", p.object_box_height);
+  readParam(pnh, "pose_covariance_topic", p.pose_covariance_topic);
+  readParam(pnh, "pose_covariance_type", p.pose_covariance_type);
   core::forEachParam(p.time, parameterServerReader(pnh));
   core::forEachParam(p.health, parameterServerReader(pnh));
   p.validate();
@@ -75,6 +81,7 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   , clock_jump_(node_params_.time.time_jump_threshold)
   , fused_window_(node_params_.health.diagnostic_window)
   , lost_window_(node_params_.health.diagnostic_window)
+  , covariance_rejected_window_(node_params_.health.diagnostic_window)
   , tf_listener_(tf_buffer_, nh)
   , reconfigure_(pnh)
 {
@@ -82,6 +89,7 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   map_grid_pub_ = nh_.advertise<EvidentialGrid>("map_grid", 1);
   for (int e = 0; e < core::FrameMG::kSize; ++e) betp_pub_[e] = nh_.advertise<nav_msgs::OccupancyGrid>(kBetpTopics[e], 1);
   decision_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("decision", 1);
+  navigable_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("navigable", 1);
   cells_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("cells", 1);
   objects_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("objects", 1);
 
@@ -93,6 +101,17 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
       [this](const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason) { onScanDropped(msg, reason); });
   prior_sub_ = nh_.subscribe("prior_grid", 1, &FusionWorker::onPrior, this);
   scan_sub_ = nh_.subscribe("scan_grid", queue, &FusionWorker::onScanIn, this);
+  if (node_params_.pose_covariance_topic.empty())
+    ROS_INFO_STREAM("fusion: no pose_covariance_topic: the prior is softened by position_sigma = "
+                    << grid_.params().position_sigma << " m");
+  else if (node_params_.pose_covariance_type == "odometry")
+    covariance_sub_ = nh_.subscribe<nav_msgs::Odometry>(
+        node_params_.pose_covariance_topic, 1,
+        [this](const nav_msgs::Odometry::ConstPtr& m) { onCovariance(m->pose.covariance); });
+  else
+    covariance_sub_ = nh_.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+        node_params_.pose_covariance_topic, 1,
+        [this](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) { onCovariance(m->pose.covariance); });
 
   reconfigure_.setCallback([this](FusionConfig& config, uint32_t level) { onReconfigure(config, level); });
 
@@ -186,9 +205,36 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  prior_ = prior;
+  softener_.setPrior(prior);
   ROS_INFO_STREAM("fusion: prior grid " << prior->geometry.width << "x" << prior->geometry.height << " cells at "
                                         << prior->geometry.resolution << " m");
+}
+
+void FusionWorker::onCovariance(const boost::array<double, 36>& covariance)
+{
+  std::array<double, 36> c;
+  std::copy(covariance.begin(), covariance.end(), c.begin());
+  double sigma = 0.0;
+  const core::CovarianceFault fault = core::positionSigma(c, sigma);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (fault != core::CovarianceFault::kNone)
+  {
+    ++counters_.covariance_rejected;
+    covariance_rejected_window_.add(core::steadySeconds());
+    ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: pose covariance on " << node_params_.pose_covariance_topic
+                                                << " rejected (" << core::toString(fault) << "); keeping sigma = "
+                                                << softener_.sigmaInForce() << " m");
+    return;
+  }
+  if (sigma > core::kMaxPositionSigma)
+  {
+    ++counters_.sigma_clamped;
+    ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: position sigma " << sigma << " m from the covariance clamped to "
+                                                                      << core::kMaxPositionSigma << " m");
+    sigma = core::kMaxPositionSigma;
+  }
+  covariance_sigma_ = sigma;
+  last_covariance_wall_ = core::steadySeconds();
 }
 
 void FusionWorker::countLost(std::size_t& counter)
@@ -403,7 +449,11 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
                                                       "still covers it");
     }
   }
-  if (!prior_ && !warned_no_prior_)
+  const double sigma = std::isnan(covariance_sigma_) ? grid_.params().position_sigma : covariance_sigma_;
+  bool softened = false;
+  const core::PriorWindow* prior = softener_.softened(sigma, &softened);
+  if (softened) ++counters_.prior_softenings;
+  if (!prior && !warned_no_prior_)
   {
     ROS_INFO("fusion: no prior_grid received yet: fusing with a vacuous prior");
     warned_no_prior_ = true;
@@ -411,7 +461,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   core::StageTimes times;
   const core::ObstaclePoints obstacles{ msg->obstacle_points.data(), msg->obstacle_points.size() / 2 };
   const auto stats =
-      grid_.update(scan, pose, stamp, prior_.get(), &times, msg->obstacle_points.empty() ? nullptr : &obstacles);
+      grid_.update(scan, pose, stamp, prior, &times, msg->obstacle_points.empty() ? nullptr : &obstacles);
   stamp_guard_.accept(stamp);
   last_pose_ = pose;
   ++counters_.fused;
@@ -436,7 +486,7 @@ void FusionWorker::publish(const std_msgs::Header& header)
     GridConversions::toMessage(grid, header, *out, PlaneSelection::kNonZero, true);
     map_grid_pub_.publish(out);
   }
-  bool need_betp = decision_pub_.getNumSubscribers() + cells_pub_.getNumSubscribers() + objects_pub_.getNumSubscribers() > 0;
+  bool need_betp = decision_pub_.getNumSubscribers() + navigable_pub_.getNumSubscribers() + cells_pub_.getNumSubscribers() + objects_pub_.getNumSubscribers() > 0;
   for (const auto& p : betp_pub_) need_betp = need_betp || p.getNumSubscribers() > 0;
   if (!need_betp) return;
   const core::PignisticPlanes& betp = grid_.pignistic();
@@ -449,14 +499,20 @@ void FusionWorker::publish(const std_msgs::Header& header)
   }
   std::vector<std::int8_t> decision;
   core::decide(grid, betp, grid_.params(), decision);
-  if (decision_pub_.getNumSubscribers() > 0)
-  {
+  const auto publishLayer = [&](ros::Publisher& pub, const std::vector<std::int8_t>& data) {
     auto occ = boost::make_shared<nav_msgs::OccupancyGrid>();
     occ->header = header;
     GridConversions::toMapMetaData(grid.geometry(), occ->info);
     occ->info.map_load_time = header.stamp;
-    occ->data = decision;
-    decision_pub_.publish(occ);
+    occ->data = data;
+    pub.publish(occ);
+  };
+  if (decision_pub_.getNumSubscribers() > 0) publishLayer(decision_pub_, decision);
+  if (navigable_pub_.getNumSubscribers() > 0)
+  {
+    std::vector<std::int8_t> navigable;
+    core::navigableLayer(decision, grid_.priorWindow(), navigable);
+    publishLayer(navigable_pub_, navigable);
   }
   if (cells_pub_.getNumSubscribers() > 0)
   {
@@ -507,7 +563,19 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("time total with outputs [ms]", 1e3 * last_total_seconds_);
   status.add("mean conflict", last_mean_conflict_);
   status.add("memory [MiB]", grid_.params().bytesNeeded() / (1024.0 * 1024.0));
-  status.add("prior", prior_ ? "received" : "none (vacuous)");
+  status.add("prior", softener_.raw() ? "received" : "none (vacuous)");
+  const bool covariance_fresh =
+      !std::isnan(covariance_sigma_) && now - last_covariance_wall_ <= node_params_.health.diagnostic_window;
+  status.add("position sigma in force [m]", softener_.sigmaInForce());
+  status.add("position sigma source",
+             node_params_.pose_covariance_topic.empty() ? std::string("position_sigma parameter")
+             : std::isnan(covariance_sigma_)            ? "position_sigma parameter (no covariance received yet)"
+             : covariance_fresh ? "covariance on " + node_params_.pose_covariance_topic
+                                : "last covariance on " + node_params_.pose_covariance_topic + " (stale)");
+  status.add("covariances rejected in window", covariance_rejected_window_.count(now));
+  status.add("covariances rejected", counters_.covariance_rejected);
+  status.add("sigma clamped (over the bound)", counters_.sigma_clamped);
+  status.add("prior softenings", counters_.prior_softenings);
 }
 
 }  // namespace map_aided_fusion

@@ -9,6 +9,7 @@
 
 #include "map_aided_fusion/EvidentialGrid.h"
 #include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "map_aided_fusion/ros/conversions.hpp"
 #include "map_aided_fusion/ros/param_loading.hpp"
 
@@ -187,7 +188,7 @@ void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::V
                     << " m x " << window.sizeY() << " m around (" << params.publish_centre_x << ", "
                     << params.publish_centre_y << ")");
   core::PriorBuildStats stats;
-  grid_.build(map, window, &stats);
+  grid_.build(map, window, &stats, params.options.cell_test);
   published_ = window;
   const core::PriorClassCounts n = grid_.classCounts();
   status_ = "published " + std::to_string(window.width) + " x " + std::to_string(window.height) + " cells: " +
@@ -195,6 +196,8 @@ void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::V
             std::to_string(n[static_cast<int>(core::PriorClass::kRoad)]) + " road, " +
             std::to_string(n[static_cast<int>(core::PriorClass::kOther)]) + " other; " +
             std::to_string(stats.buildings_rasterised) + " buildings rasterised, " +
+            std::to_string(stats.outline_cells) + " outline cells (cell_test " + core::toString(params.options.cell_test) +
+            "), " +
             std::to_string(map.skipped_geometries + stats.skipped_invalid) + " geometries skipped";
   ROS_INFO_STREAM("prior_grid: " << status_);
 
@@ -203,7 +206,7 @@ void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::V
   header.frame_id = params.frame_id;
 
   core::PriorWindow prior;
-  grid_.fillWindow(window, params.beta, prior);
+  core::mapPrior(grid_, window, params.beta, params.options, prior);
   EvidentialGrid msg;
   GridConversions::toMessage(prior, header, msg);
   prior_pub_.publish(msg);

@@ -16,8 +16,10 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
+#include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -29,6 +31,7 @@
 #include "map_aided_fusion/GroundTruthObjectArray.h"
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
+#include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/eval/metrics.hpp"
@@ -169,11 +172,17 @@ struct Variant
   bool builder_ready = false;
   core::ScanMassGrid scan;
   bool use_prior;
+  core::PriorGridOptions prior_options;
+  core::PriorSoftener softener;
   eval::ClassGrid decision;
   eval::PointLabelScorer points;
   Variant(const std::string& name, const std::string& description, const core::Profile& profile, bool prior,
           double match_radius)
-    : grid(profile.map_grid), scan_params(profile.scan_grid), use_prior(prior), points(match_radius)
+    : grid(profile.map_grid)
+    , scan_params(profile.scan_grid)
+    , use_prior(prior)
+    , prior_options(profile.prior)
+    , points(match_radius)
   {
     scores.name = name;
     scores.description = description;
@@ -249,10 +258,17 @@ Options parse(int argc, char** argv)
   return o;
 }
 
-std::optional<core::PriorWindow> loadPrior(const Options& o, const YAML::Node& prior_cfg, double resolution,
-                                           std::string& summary)
+/// The map and the PriorGrid parameters of the prior config (β, resolution), or nothing without a map.
+struct MapSource
 {
-  map_io::PriorGridParams pp;
+  map_io::PriorGridParams params;
+  core::VectorMap map;
+};
+
+std::optional<MapSource> loadMap(const Options& o, const YAML::Node& prior_cfg, std::string& summary)
+{
+  MapSource src;
+  map_io::PriorGridParams& pp = src.params;
   map_io::forEachPriorGridParam(pp, map_io::yamlReader(prior_cfg));
   if (!o.map.empty()) pp.map.file = o.map;
   if (pp.map.file.empty())
@@ -267,13 +283,21 @@ std::optional<core::PriorWindow> loadPrior(const Options& o, const YAML::Node& p
     pp.map.origin_altitude = (*o.origin)[2];
   }
   pp.beta.validate();
+  pp.options.validate();
   map_io::MapLoadReport report;
-  const core::VectorMap vm = map_io::loadVectorMap(pp.map, &report);
-  const core::PriorGrid grid = core::PriorGrid::fromVectorMap(vm, resolution);
-  core::PriorWindow window;
-  grid.fillWindow(grid.geometry(), pp.beta, window);
-  summary = pp.map.file + ": " + std::to_string(vm.buildings.size()) + " buildings, " +
-            std::to_string(vm.road_areas.size()) + " road surfaces";
+  src.map = map_io::loadVectorMap(pp.map, &report);
+  summary = pp.map.file + ": " + std::to_string(src.map.buildings.size()) + " buildings, " +
+            std::to_string(src.map.road_areas.size()) + " road surfaces";
+  return src;
+}
+
+/// The prior masses of the whole map for one way of making the PriorGrid (cell test, map accuracy).
+std::shared_ptr<const core::PriorWindow> makePrior(const MapSource& src, const core::PriorGridOptions& options,
+                                                   double resolution)
+{
+  const core::PriorGrid grid = core::PriorGrid::fromVectorMap(src.map, resolution, 0.0, nullptr, options.cell_test);
+  auto window = std::make_shared<core::PriorWindow>();
+  core::mapPrior(grid, grid.geometry(), src.params.beta, options, *window);
   return window;
 }
 
@@ -319,8 +343,14 @@ int main(int argc, char** argv)
     configured.map_grid = fusionParams(fusion_cfg);
     configured.scan_grid = scanGridParams(scan_cfg);
     std::string prior_summary;
-    const std::optional<core::PriorWindow> prior =
-        loadPrior(opt, prior_cfg, configured.map_grid.resolution, prior_summary);
+    const std::optional<MapSource> map_source = loadMap(opt, prior_cfg, prior_summary);
+    if (map_source) configured.prior = map_source->params.options;
+    const bool prior = map_source.has_value();
+    std::string covariance_topic, covariance_type = "pose";
+    if (fusion_cfg["pose_covariance_topic"]) covariance_topic = fusion_cfg["pose_covariance_topic"].as<std::string>();
+    if (fusion_cfg["pose_covariance_type"]) covariance_type = fusion_cfg["pose_covariance_type"].as<std::string>();
+    std::map<std::int64_t, double> covariance_sigma;
+    std::size_t covariance_rejected = 0;
 
     // Pass 1: tf, ground truth.
     rosbag::Bag bag;
@@ -357,6 +387,28 @@ int main(int argc, char** argv)
         {
           ++clouds;
         }
+        else if (!covariance_topic.empty() && topic == covariance_topic)
+        {
+          std::array<double, 36> c{};
+          ros::Time stamp;
+          if (auto msg = m.instantiate<geometry_msgs::PoseWithCovarianceStamped>(); msg && covariance_type == "pose")
+          {
+            std::copy(msg->pose.covariance.begin(), msg->pose.covariance.end(), c.begin());
+            stamp = msg->header.stamp;
+          }
+          else if (auto od = m.instantiate<nav_msgs::Odometry>(); od && covariance_type == "odometry")
+          {
+            std::copy(od->pose.covariance.begin(), od->pose.covariance.end(), c.begin());
+            stamp = od->header.stamp;
+          }
+          else
+            continue;
+          double sigma = 0.0;
+          if (core::positionSigma(c, sigma) == core::CovarianceFault::kNone)
+            covariance_sigma[key(stamp)] = std::min(sigma, core::kMaxPositionSigma);
+          else
+            ++covariance_rejected;
+        }
       }
     }
     if (clouds == 0) throw std::runtime_error(opt.bag + " has no /points");
@@ -366,12 +418,21 @@ int main(int argc, char** argv)
                                          "(labelled real data, kitti_to_bag)");
 
     std::vector<std::unique_ptr<Variant>> variants;
+    std::vector<std::pair<core::PriorGridOptions, std::shared_ptr<const core::PriorWindow>>> priors;
+    auto priorFor = [&](const core::PriorGridOptions& o) {
+      for (const auto& [k, w] : priors)
+        if (k.cell_test == o.cell_test && k.building_accuracy == o.building_accuracy && k.road_accuracy == o.road_accuracy)
+          return w;
+      priors.emplace_back(o, makePrior(*map_source, o, configured.map_grid.resolution));
+      return priors.back().second;
+    };
     auto add = [&](const std::string& name, const std::string& description, const core::Profile& profile, bool use_prior) {
       if (use_prior && !prior) return;
       variants.push_back(std::make_unique<Variant>(name, description, profile, use_prior, opt.match_radius));
+      if (use_prior) variants.back()->softener.setPrior(priorFor(profile.prior));
     };
     const core::Profile paper = core::paperProfile();
-    const bool have_prior = prior.has_value();
+    const bool have_prior = prior;
     add("default", "the configured method (config/*.yaml: the paper's pipeline and the steps this package adds)",
         configured, have_prior);
     add("paper", "the paper's exact method (config/paper/*.yaml: prior, contextual discounting, modified Yager rule, "
@@ -508,7 +569,10 @@ int main(int argc, char** argv)
           v->builder.setSensorPose(KittiConversions::toIsometry(sensor));
         v->builder.build(pv, v->scan);
         const core::ObstaclePoints obstacles = v->builder.obstaclePoints();
-        v->grid.update(v->scan, pose, t, v->use_prior ? &*prior : nullptr, nullptr, &obstacles);
+        double sigma = v->grid.params().position_sigma;
+        if (auto c = covariance_sigma.upper_bound(k); c != covariance_sigma.begin()) sigma = std::prev(c)->second;
+        const core::PriorWindow* pw = v->use_prior ? v->softener.softened(sigma) : nullptr;
+        v->grid.update(v->scan, pose, t, pw, nullptr, &obstacles);
         v->decision.geometry = v->grid.geometry();
         core::decide(v->grid.masses(), v->grid.pignistic(), v->grid.params(), v->decision.cells);
         if (point_mode)
@@ -598,11 +662,16 @@ int main(int argc, char** argv)
           if (prior)
           {
             const auto& g = variants[0]->grid.geometry();
-            core::PriorWindow w;
-            core::extractPriorWindow(*prior, g, w);
+            const core::PriorWindow& w = variants[0]->grid.priorWindow();
             std::vector<std::int8_t> labels(g.numCells());
             for (std::size_t i = 0; i < labels.size(); ++i)
-              labels[i] = w.building[i] > 0.0f ? 1 : w.road[i] > 0.0f ? 2 : w.other[i] > 0.0f ? 3 : 0;
+            {
+              const float b = w.building[i] + w.wall[i];
+              labels[i] = b > 0.0f && b >= w.road[i] && b >= w.other[i] ? 1
+                          : w.road[i] > 0.0f && w.road[i] >= w.other[i] ? 2
+                          : w.other[i] > 0.0f                           ? 3
+                                                                        : 0;
+            }
             writeNpy(dir / "figure_prior.npy", labels.data(),
                      { static_cast<std::size_t>(g.height), static_cast<std::size_t>(g.width) }, "|i1");
           }
@@ -668,6 +737,9 @@ int main(int argc, char** argv)
     std::map<std::string, std::string> meta{ { "bag", opt.bag },
                                              { "ground_truth", point_mode ? "labelled points" : "simulator cells" },
                                              { "prior", prior_summary },
+                                             { "pose_covariances", std::to_string(covariance_sigma.size()) + " on '" +
+                                                                       covariance_topic + "', " +
+                                                                       std::to_string(covariance_rejected) + " rejected" },
                                              { "scans", std::to_string(done) },
                                              { "scans_without_pose", std::to_string(no_pose) },
                                              { "scans_without_ground_truth", std::to_string(no_truth) },

@@ -44,13 +44,28 @@ ScanMassGrid randomScanGrid(std::mt19937& rng, const GridGeometry& g)
   return grid;
 }
 
-PriorWindow randomPrior(std::mt19937& rng, const GridGeometry& g, const PriorConfidence& beta)
+/// Equation 1's classes at random and, with @p walls, outline cells m({F, C}) = β_B and mixed cells (coverage).
+PriorWindow randomPrior(std::mt19937& rng, const GridGeometry& g, const PriorConfidence& beta, bool walls = true)
 {
   PriorWindow p(g);
-  std::uniform_int_distribution<int> cls(0, kNumPriorClasses - 1);
+  std::uniform_int_distribution<int> cls(0, kNumPriorClasses + (walls ? 1 : -1));
+  std::uniform_real_distribution<float> share(0.0f, 1.0f);
   for (std::size_t i = 0; i < g.numCells(); ++i)
   {
-    const auto c = static_cast<PriorClass>(cls(rng));
+    const int k = cls(rng);
+    if (k == kNumPriorClasses)
+    {
+      p.wall[i] = static_cast<float>(beta.beta_building);
+      continue;
+    }
+    if (k == kNumPriorClasses + 1)
+    {
+      const float a = share(rng);
+      p.road[i] = static_cast<float>(beta.beta_road) * a;
+      p.other[i] = static_cast<float>(beta.beta_other) * (1.0f - a);
+      continue;
+    }
+    const auto c = static_cast<PriorClass>(k);
     const auto m = priorMass(c, beta);
     p.building[i] = static_cast<float>(m[FrameMG::kBuilding]);
     p.road[i] = static_cast<float>(m[FrameMG::kRoad]);
@@ -200,7 +215,7 @@ TEST(GridOps, PignisticMatchesScalar)
 TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
 {
   for (auto mode : { SpecialisationMode::kMovingToStopped, SpecialisationMode::kLiteral })
-    for (bool with_prior : { true, false })
+    for (int with_prior : { 2, 1, 0 })  // 2: with outline cells, 1: equation 1 only, 0: none
     {
       std::mt19937 rng(8);
       const auto g = testGeometry();
@@ -208,7 +223,8 @@ TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
       auto map = randomMapGrid(rng, g);
       const auto before = map;
       const auto scan = randomScanGrid(rng, g);
-      const auto prior = randomPrior(rng, g, beta);
+      const auto prior = randomPrior(rng, g, beta, with_prior == 2);
+      ASSERT_EQ(prior.hasWall(), with_prior == 2);
       FusionParams params;
       params.moving_expiry = false;  // the paper's sequence of grid ops; the step is tested in test_motion_steps
       params.counter.mode = mode;

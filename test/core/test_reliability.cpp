@@ -139,7 +139,7 @@ TEST(StreamHealth, WarnsAndErrsWhenScansStopAndRecovers)
 
 TEST(MemoryBudget, HugeWindowIsRefusedBeforeAllocationWithTheBytesNeeded)
 {
-  EXPECT_EQ(MapGridParams::bytesPerCell(), (32u + 1u + 5u + 4u + 3u) * sizeof(float) + 1u);
+  EXPECT_EQ(MapGridParams::bytesPerCell(), (32u + 1u + 5u + 4u + 4u + 1u) * sizeof(float) + 1u);
   MapGridParams p;
   p.size_x = p.size_y = 4096.0;  // 8192 x 8192 cells at 0.5 m: 12 GB
   try

@@ -9,6 +9,7 @@
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
+#include "map_aided_fusion/map_io/yaml_params.hpp"
 
 namespace {
 
@@ -172,7 +173,22 @@ TEST(Profiles, ConfigFilesHoldTheDefaultAndThePaperProfiles)
   EXPECT_EQ(valuesOf(loadFile<core::MapGridParams>(dir + "paper/fusion.yaml")), valuesOf(paper.map_grid));
   EXPECT_EQ(valuesOf(loadFile<core::ScanGridParams>(dir + "paper/scan_grid.yaml")), valuesOf(paper.scan_grid));
   EXPECT_NE(valuesOf(paper.map_grid), valuesOf(def.map_grid));
-  // The PriorGrid is the same in both profiles.
+  // The PriorGrid: the profiles' options (cell test, map accuracy); every other key the same in both files.
   const YAML::Node a = YAML::LoadFile(dir + "prior_grid.yaml"), b = YAML::LoadFile(dir + "paper/prior_grid.yaml");
-  for (const auto& kv : a) EXPECT_EQ(YAML::Dump(kv.second), YAML::Dump(b[kv.first.as<std::string>()])) << kv.first;
+  map_io::PriorGridParams pa, pb;
+  map_io::forEachPriorGridParam(pa, map_io::yamlReader(a));
+  map_io::forEachPriorGridParam(pb, map_io::yamlReader(b));
+  for (const auto& [file, want] : { std::make_pair(pa.options, def.prior), std::make_pair(pb.options, paper.prior) })
+  {
+    EXPECT_EQ(file.cell_test, want.cell_test);
+    EXPECT_EQ(file.building_accuracy, want.building_accuracy);
+    EXPECT_EQ(file.road_accuracy, want.road_accuracy);
+  }
+  EXPECT_EQ(paper.prior.cell_test, core::PriorCellTest::kCentre);
+  const std::set<std::string> options{ "cell_test", "building_accuracy", "road_accuracy" };
+  for (const auto& kv : a)
+  {
+    if (options.count(kv.first.as<std::string>())) continue;
+    EXPECT_EQ(YAML::Dump(kv.second), YAML::Dump(b[kv.first.as<std::string>()])) << kv.first;
+  }
 }

@@ -40,6 +40,7 @@ struct FrameMG
   static constexpr Subset kBuilding = kC;             ///< B of the PriorGrid
   static constexpr Subset kRoad = kF | kS | kV;       ///< R of the PriorGrid
   static constexpr Subset kOther = kF | kN | kS | kV; ///< T of the PriorGrid
+  static constexpr Subset kWall = kF | kC;            ///< W of the PriorGrid: a cell a building outline crosses
   static constexpr Subset kStatic = kC | kN;          ///< θ_static of the coarsening Θ
   static constexpr Subset kDynamic = kS | kV;         ///< θ_dynamic of the coarsening Θ
   static constexpr Subset kFreeContext = kF;          ///< θ_free of the coarsening Θ

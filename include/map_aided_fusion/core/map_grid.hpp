@@ -83,6 +83,19 @@ struct MapGridParams
    * by a hair. In [0, 1]; 0 disables it.
    */
   double motion_margin = 0.1;
+  /**
+   * Step "map conflict" (not in the paper): a per-cell doubt η in [0, 1] about the map, kept with the window. Each
+   * scan, η += map_conflict_gain · (K − A), K = m_PG(B)·m_SG(F) the scan's conflict with a mapped building, A =
+   * (m_PG(B) + m_PG(W))·m_SG(O) its agreement, clamped to [0, 1]; the prior is discounted by η before it is
+   * combined (m_PG ← (1 − η)·m_PG, the rest to Ω). A building that is mapped but no longer there (or that the pose
+   * error moves) stops being called C once the lidar keeps seeing through it. In [0, 1]; 0 disables it.
+   */
+  double map_conflict_gain = 0.2;
+  /**
+   * σ of the vehicle's position, metres in [0, 5], by which the prior is softened (prior_uncertainty.hpp) when no
+   * pose covariance is configured or received; a received covariance replaces it. 0: the prior as published.
+   */
+  double position_sigma = 0.0;
   /// Bytes one window cell needs in the MapGrid and its per-scan buffers.
   static std::size_t bytesPerCell();
   /// Bytes the window of these parameters needs (cells × bytesPerCell()).
@@ -122,6 +135,8 @@ void forEachParam(MapGridParams& p, Get&& get)
   get("motion_max_cells", p.motion_max_cells);
   get("motion_margin", p.motion_margin);
   get("obstacle_clearance", p.obstacle_clearance);
+  get("map_conflict_gain", p.map_conflict_gain);
+  get("position_sigma", p.position_sigma);
 }
 
 /// Wall time of each stage of MapGrid::update(), seconds.
@@ -172,6 +187,12 @@ void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const Gr
  *        neighbour; an exact copy when the lattices are aligned). Cells outside @p prior are vacuous.
  */
 void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out);
+
+/**
+ * @brief Step map_conflict (MapGridParams::map_conflict_gain): updates the doubt η of each cell from the scan
+ *        @p scan (same geometry) and discounts @p prior by it in place. @p doubt is resized (zeros) when needed.
+ */
+void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt);
 
 /**
  * @brief Decision per cell: the class of largest BetP when it reaches @p threshold, kUnknown otherwise or
@@ -247,12 +268,17 @@ public:
   const PignisticPlanes& pignistic() const { return betp_; }
   /// Number of scans fused since the last reset.
   std::size_t scans() const { return scans_; }
+  /// The map doubt η of every window cell (step map_conflict; zeros when it is off).
+  const AlignedVector<float>& mapDoubt() const { return map_doubt_; }
+  /// The prior window of the last update, after the map doubt (vacuous without a prior).
+  const PriorWindow& priorWindow() const { return prior_window_; }
 
 private:
   MapGridParams params_;
   MapMassGrid grid_;
   ScanMassGrid scan_window_;
   PriorWindow prior_window_;
+  AlignedVector<float> map_doubt_;
   PignisticPlanes betp_;
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;

@@ -94,8 +94,9 @@ using MapMassGrid = MassGrid<FrameMG>;
 using ScanMassGrid = MassGrid<FrameSG>;
 
 /**
- * @brief The prior masses of a window (equation 1): m(B), m(R), m(T) per cell, m(Ω) = 1 − their sum.
- *        All zero means a vacuous prior.
+ * @brief The prior masses of a window: m(B), m(R), m(T) (equation 1) and m(W = {F, C}) (a cell a building's
+ *        outline crosses: occupied there is the wall, the rest of the cell may be free) per cell,
+ *        m(Ω) = 1 − their sum. All zero means a vacuous prior.
  */
 struct PriorWindow
 {
@@ -103,6 +104,7 @@ struct PriorWindow
   AlignedVector<float> building;  ///< m_PG(B = {C})
   AlignedVector<float> road;      ///< m_PG(R = {F,S,V})
   AlignedVector<float> other;     ///< m_PG(T = {F,N,S,V})
+  AlignedVector<float> wall;      ///< m_PG(W = {F,C}); zero in the paper's prior
 
   PriorWindow() = default;
   /// A vacuous prior window of the given geometry.
@@ -113,14 +115,18 @@ struct PriorWindow
     building.assign(g.numCells(), 0.0f);
     road.assign(g.numCells(), 0.0f);
     other.assign(g.numCells(), 0.0f);
+    wall.assign(g.numCells(), 0.0f);
   }
+  /// True when some cell carries mass on W.
+  bool hasWall() const;
   /// The prior mass function of cell @p i.
   MassMG cell(std::size_t i) const
   {
     return MassMG{ { FrameMG::kBuilding, building[i] },
                    { FrameMG::kRoad, road[i] },
                    { FrameMG::kOther, other[i] },
-                   { FrameMG::kOmega, 1.0 - double(building[i]) - double(road[i]) - double(other[i]) } };
+                   { FrameMG::kWall, wall[i] },
+                   { FrameMG::kOmega, 1.0 - double(building[i]) - double(road[i]) - double(other[i]) - double(wall[i]) } };
   }
 };
 

@@ -11,16 +11,18 @@
 #include <vector>
 
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 
 namespace map_aided_fusion {
 namespace core {
 
-/// The parameters of the ScanGrid and of the MapGrid (the PriorGrid is the same in both profiles).
+/// The parameters of the ScanGrid, of the MapGrid and how the PriorGrid is made (its β are the same in both).
 struct Profile
 {
   ScanGridParams scan_grid;
   MapGridParams map_grid;
+  PriorGridOptions prior;
 };
 
 /**

@@ -10,6 +10,7 @@
  */
 #pragma once
 
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -72,6 +73,46 @@ private:
 /// Polygons covering a road centre line buffered by half its width: one rectangle per segment and a regular
 /// polygon approximating a disc at every vertex (round joins and caps). Appends to @p out.
 void bufferRoadLine(const RoadLine& line, std::vector<Ring>& out);
+
+/**
+ * @brief Calls @p visit(index) for every cell of @p grid that the 2D segment from @p origin along the unit
+ *        direction (dx, dy) over [0, length] passes through, in order (Amanatides & Woo).
+ */
+template <class Visit>
+void traverseCells(const GridGeometry& grid, Point2 origin, double dx, double dy, double length,
+                   Visit&& visit)
+{
+  const double res = grid.resolution;
+  double fx = (origin.x - grid.origin_x) / res, fy = (origin.y - grid.origin_y) / res;
+  int ix = static_cast<int>(std::floor(fx)), iy = static_cast<int>(std::floor(fy));
+  const int step_x = dx > 0.0 ? 1 : -1, step_y = dy > 0.0 ? 1 : -1;
+  constexpr double kInf = 1e300;
+  double t_max_x = dx != 0.0 ? ((ix + (dx > 0.0 ? 1 : 0)) - fx) * res / dx : kInf;
+  double t_max_y = dy != 0.0 ? ((iy + (dy > 0.0 ? 1 : 0)) - fy) * res / dy : kInf;
+  const double dt_x = dx != 0.0 ? res / std::abs(dx) : kInf;
+  const double dt_y = dy != 0.0 ? res / std::abs(dy) : kInf;
+  double t = 0.0;
+  while (t <= length)
+  {
+    if (ix >= 0 && iy >= 0 && ix < grid.width && iy < grid.height)
+      visit(static_cast<std::size_t>(iy) * static_cast<std::size_t>(grid.width) + static_cast<std::size_t>(ix));
+    else if ((ix < 0 && step_x < 0) || (iy < 0 && step_y < 0) || (ix >= grid.width && step_x > 0) ||
+             (iy >= grid.height && step_y > 0))
+      return;  // outside and moving away
+    if (t_max_x < t_max_y)
+    {
+      t = t_max_x;
+      t_max_x += dt_x;
+      ix += step_x;
+    }
+    else
+    {
+      t = t_max_y;
+      t_max_y += dt_y;
+      iy += step_y;
+    }
+  }
+}
 
 }  // namespace core
 }  // namespace map_aided_fusion

@@ -10,6 +10,7 @@
 
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/core/prior.hpp"
+#include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
 
 namespace map_aided_fusion {
@@ -22,6 +23,7 @@ struct PriorGridParams
   std::string frame_id = "map";     ///< frame of the published grids and markers
   double resolution = 0.5;          ///< cell side, metres (> 0)
   core::PriorConfidence beta;       ///< β_B, β_R, β_T of equation 1, each in [0, 1] (defaults 0.9, 0.9, 0.8)
+  core::PriorGridOptions options;   ///< cell_test, building_accuracy, road_accuracy (m) (core/prior_grid.hpp)
   double margin = 0.0;              ///< metres added around the map's extent (>= 0)
   /// Side in metres of the square published around (publish_centre_x, publish_centre_y); 0: the map's extent.
   double publish_size = 0.0;
@@ -82,6 +84,11 @@ void forEachPriorGridParam(PriorGridParams& p, Get&& get)
   get("beta_building", p.beta.beta_building);
   get("beta_road", p.beta.beta_road);
   get("beta_other", p.beta.beta_other);
+  std::string cell_test = core::toString(p.options.cell_test);
+  get("cell_test", cell_test);
+  p.options.cell_test = core::parsePriorCellTest(cell_test);
+  get("building_accuracy", p.options.building_accuracy);
+  get("road_accuracy", p.options.road_accuracy);
   get("margin", p.margin);
   get("publish_size", p.publish_size);
   get("publish_centre_x", p.publish_centre_x);

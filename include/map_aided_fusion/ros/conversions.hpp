@@ -56,12 +56,12 @@ public:
   static void fromMessage(const EvidentialGrid& msg, core::MassGrid<Frame>& grid);
 
   /**
-   * @brief EvidentialGrid of a PriorGrid (focal sets among B, R, T, Ω and ∅) → PriorWindow.
+   * @brief EvidentialGrid of a PriorGrid (focal sets among B, R, T, W = {F, C}, Ω and ∅) → PriorWindow.
    * @throws ConversionError when another focal set carries mass, or as fromMessage().
    */
   static void fromMessage(const EvidentialGrid& msg, core::PriorWindow& prior);
 
-  /// A PriorWindow → EvidentialGrid with the focal sets B, R, T and Ω.
+  /// A PriorWindow → EvidentialGrid with the focal sets B, R, T and Ω, and W when some cell has mass on it.
   static void toMessage(const core::PriorWindow& prior, const std_msgs::Header& header, EvidentialGrid& msg);
 
   /**

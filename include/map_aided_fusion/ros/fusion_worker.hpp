@@ -6,6 +6,7 @@
  */
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -21,6 +22,7 @@
 #include "map_aided_fusion/EvidentialGrid.h"
 #include "map_aided_fusion/FusionConfig.h"
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "map_aided_fusion/core/sliding_window.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
 
@@ -40,6 +42,9 @@ struct FusionCounters
   std::size_t tf_clears = 0;            ///< tf buffer cleared (time jump, or transforms ahead of the clock)
   std::size_t pose_jumps = 0;           ///< vehicle moved faster than max_plausible_speed between two scans
   std::size_t reconfigure_refused = 0;  ///< dynamic_reconfigure requests refused
+  std::size_t covariance_rejected = 0;  ///< pose covariances refused (NaN, negative variance, asymmetric)
+  std::size_t sigma_clamped = 0;        ///< covariances whose σ exceeded core::kMaxPositionSigma (clamped)
+  std::size_t prior_softenings = 0;     ///< times the prior was softened anew (new prior or σ changed)
 };
 
 /// The fusion node's own parameters besides the MapGrid's (config/fusion.yaml).
@@ -51,6 +56,10 @@ struct FusionNodeParams
   double future_tolerance = 1.0;        ///< s a scan may be stamped ahead of the clock, [0, 3600]
   bool publish_free_cells = false;      ///< also draw free cells in `cells`
   double object_box_height = 1.5;       ///< m, height of the object boxes, (0, 100]
+  /// Topic of the vehicle's pose covariance ("" : none, the MapGrid's position_sigma is used).
+  std::string pose_covariance_topic;
+  /// Its type: "pose" (geometry_msgs/PoseWithCovarianceStamped) or "odometry" (nav_msgs/Odometry).
+  std::string pose_covariance_type = "pose";
   core::TimeGuardParams time;           ///< out-of-order, time-jump and pose-jump thresholds
   core::StreamHealthParams health;      ///< diagnostics period, window and staleness
   /// @throws core::ParameterError naming the first bad parameter.
@@ -60,7 +69,8 @@ struct FusionNodeParams
 };
 
 /**
- * Topics: in `scan_grid`, `prior_grid`; out `map_grid`, `betp/<class>`, `decision`, `cells`, `objects`.
+ * Topics: in `scan_grid`, `prior_grid`, and the pose covariance when configured; out `map_grid`, `betp/<class>`,
+ * `decision`, `navigable`, `cells`, `objects`.
  *
  * Time: scans are fused in stamp order. A scan stamped 0, further ahead of the clock than
  * future_tolerance, with the stamp of the last fused one, or older than it by at most time_jump_threshold
@@ -90,6 +100,8 @@ private:
   void countLost(std::size_t& counter);
   void onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason);
   void onPrior(const EvidentialGrid::ConstPtr& msg);
+  /// A pose covariance (6 × 6 row-major): a new σ, or a counted, throttled rejection keeping the last good σ.
+  void onCovariance(const boost::array<double, 36>& covariance);
   void onReconfigure(FusionConfig& config, uint32_t level);
   void publish(const std_msgs::Header& header);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -100,14 +112,17 @@ private:
   std::mutex mutex_;
   core::MapGrid grid_;
   std::optional<core::MapGridParams> pending_params_;
-  std::shared_ptr<core::PriorWindow> prior_;
+  core::PriorSoftener softener_;
   bool warned_no_prior_ = false;
+  double covariance_sigma_ = std::numeric_limits<double>::quiet_NaN();  ///< σ of the last good covariance, m
+  double last_covariance_wall_ = 0.0;
   core::StampGuard stamp_guard_;
   core::ClockJumpDetector clock_jump_;
   std::optional<core::Pose2> last_pose_;
   std::string last_scan_frame_;
   FusionCounters counters_;
   core::SlidingCounter fused_window_, lost_window_;
+  core::SlidingCounter covariance_rejected_window_;
   double start_wall_ = 0.0;
   double last_fused_wall_ = 0.0;
   core::StageTimes last_times_;
@@ -118,8 +133,8 @@ private:
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   std::unique_ptr<tf2_ros::MessageFilter<EvidentialGrid>> scan_filter_;
-  ros::Subscriber scan_sub_, prior_sub_;
-  ros::Publisher map_grid_pub_, decision_pub_, cells_pub_, objects_pub_;
+  ros::Subscriber scan_sub_, prior_sub_, covariance_sub_;
+  ros::Publisher map_grid_pub_, decision_pub_, navigable_pub_, cells_pub_, objects_pub_;
   ros::Publisher betp_pub_[core::FrameMG::kSize];
   dynamic_reconfigure::Server<FusionConfig> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
