@@ -2,6 +2,7 @@
 
 #include <geometry_msgs/TransformStamped.h>
 #include <rosbag/bag.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include <chrono>
@@ -130,7 +131,7 @@ SimBagStats writeSimulationBag(sim::Simulator& simulator, const SimBagOptions& o
     for (; tf_index < tf_count && tf_index * tf_period <= t_end + 1e-9; ++tf_index)
     {
       const double t = tf_index * tf_period;
-      const sim::Pose2 ego = simulator.egoPose(t);
+      const sim::Pose2 ego = simulator.reportedEgoPose(t);
       tf2_msgs::TFMessage tf;
       geometry_msgs::TransformStamped ts;
       ts.header.stamp = SimConversions::stamp(sc, t);
@@ -142,6 +143,18 @@ SimBagStats writeSimulationBag(sim::Simulator& simulator, const SimBagOptions& o
       tf.transforms.push_back(ts);
       bag.write(n.tf_topic, ts.header.stamp, tf);
       ++stats.tf_messages;
+      const sim::LocalisationError& le = sc.localisation_error;
+      const long every = std::max(1L, std::lround(sc.tf_rate_hz / le.covariance_rate_hz));
+      if (!le.any() || tf_index % every != 0) continue;
+      geometry_msgs::PoseWithCovarianceStamped pose;
+      pose.header = ts.header;
+      pose.pose.pose.position.x = ego.x;
+      pose.pose.pose.position.y = ego.y;
+      pose.pose.pose.orientation = ts.transform.rotation;
+      const double var = le.reportedSigma() * le.reportedSigma();
+      pose.pose.covariance[0] = pose.pose.covariance[7] = var;
+      pose.pose.covariance[14] = pose.pose.covariance[21] = pose.pose.covariance[28] = pose.pose.covariance[35] = 1e-4;
+      bag.write(n.pose_topic, ts.header.stamp, pose);
     }
   };
 

@@ -21,6 +21,8 @@ constexpr double kMaxTfRate = 1000.0;
 constexpr double kMaxGtSize = 2000.0;
 constexpr double kMaxObjectSize = 50.0;
 constexpr double kMaxBuildingHeight = 1000.0;
+/// Largest pose or map error a scenario may ask for, metres.
+constexpr double kMaxLocalisationError = 50.0;
 constexpr double kMaxStopSpeed = 5.0;
 
 using core::ParameterError;
@@ -159,6 +161,12 @@ void GroundTruthParams::validate() const
   core::requireInRange("ground_truth.stop_speed", stop_speed, 0.0, kMaxStopSpeed);
 }
 
+double LocalisationError::reportedSigma() const
+{
+  if (reported_sigma >= 0.0) return reported_sigma;
+  return std::sqrt(bias.x * bias.x + bias.y * bias.y + random_walk * random_walk + white_noise * white_noise);
+}
+
 void Scenario::validate() const
 {
   core::requireInRange("duration", duration, 0.0, kMaxDuration);
@@ -189,6 +197,18 @@ void Scenario::validate() const
     }
     o.motion.validate(p);
   }
+  const LocalisationError& le = localisation_error;
+  core::requireInRange("localisation_error.bias", std::hypot(le.bias.x, le.bias.y), 0.0, kMaxLocalisationError);
+  core::requireInRange("localisation_error.bias_yaw_deg", le.bias_yaw_deg, -180.0, 180.0);
+  core::requireInRange("localisation_error.random_walk", le.random_walk, 0.0, kMaxLocalisationError);
+  core::requireInRange("localisation_error.random_walk_time", le.random_walk_time, 0.1, kMaxDuration);
+  core::requireInRange("localisation_error.white_noise", le.white_noise, 0.0, kMaxLocalisationError);
+  core::requireInRange("localisation_error.reported_sigma", le.reported_sigma, -1.0, kMaxLocalisationError);
+  core::requireInRange("localisation_error.covariance_rate_hz", le.covariance_rate_hz, 0.1, kMaxTfRate);
+  core::requireInRange("map_errors.shift", std::hypot(map_errors.shift.x, map_errors.shift.y), 0.0, kMaxLocalisationError);
+  core::requireInRange("map_errors.rotation_deg", map_errors.rotation_deg, -180.0, 180.0);
+  for (const BuildingOffset& o : map_errors.offsets)
+    core::requireInRange("map_errors.offset_buildings.offset", std::hypot(o.offset.x, o.offset.y), 0.0, kMaxLocalisationError);
   for (const WorldBuilding& b : map_errors.unmapped)
   {
     if (b.footprint.outer.size() < 3)
@@ -209,6 +229,24 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
     throw ParameterError("yaml", e.what());
   }
   if (!root.IsMap()) throw ParameterError("yaml", "a scenario must be a YAML mapping");
+  if (const YAML::Node base = root["base"])
+  {
+    const std::string name = get<std::string>(root, "base", "", "");
+    const std::string path = (name.front() == '/' || base_dir.empty()) ? name : base_dir + "/" + name;
+    YAML::Node merged;
+    try
+    {
+      merged = YAML::LoadFile(path);
+    }
+    catch (const YAML::Exception& e)
+    {
+      throw ParameterError("base", "cannot read scenario '" + path + "': " + e.what());
+    }
+    if (!merged.IsMap() || merged["base"]) throw ParameterError("base", "'" + path + "' must be a scenario without a base");
+    for (const auto& kv : root)
+      if (kv.first.as<std::string>() != "base") merged[kv.first.as<std::string>()] = kv.second;
+    root = merged;
+  }
   Scenario sc;
   sc.name = get<std::string>(root, "name", "", sc.name);
   const std::string map = get<std::string>(root, "map", "", "");
@@ -279,6 +317,20 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
         b.cell_class = core::CellClass::kInfrastructure;
         sc.map_errors.unmapped.push_back(std::move(b));
       }
+    if (const YAML::Node shift = errors["shift"]) sc.map_errors.shift = toPoint(shift, "map_errors.shift");
+    sc.map_errors.rotation_deg = get<double>(errors, "rotation_deg", "map_errors.", 0.0);
+    if (const YAML::Node o = errors["offset_buildings"])
+      for (std::size_t i = 0; i < o.size(); ++i)
+      {
+        const std::string p = "map_errors.offset_buildings[" + std::to_string(i) + "].";
+        BuildingOffset b;
+        if (o[i]["at"]) b.at = toPoint(o[i]["at"], p + "at");
+        else if (o[i]["id"]) b.id = get<std::string>(o[i], "id", p, "");
+        else throw ParameterError(p + "at", "an offset building needs 'at: [x, y]' or 'id: ...'");
+        if (!o[i]["offset"]) throw ParameterError(p + "offset", "is required: [dx, dy] in metres");
+        b.offset = toPoint(o[i]["offset"], p + "offset");
+        sc.map_errors.offsets.push_back(std::move(b));
+      }
     if (const YAML::Node a = errors["absent_buildings"])
       for (std::size_t i = 0; i < a.size(); ++i)
       {
@@ -287,6 +339,19 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
         else if (a[i]["id"]) sc.map_errors.absent_ids.push_back(get<std::string>(a[i], "id", p, ""));
         else throw ParameterError(p + "at", "an absent building needs 'at: [x, y]' or 'id: ...'");
       }
+  }
+
+  if (const YAML::Node l = root["localisation_error"])
+  {
+    LocalisationError& e = sc.localisation_error;
+    const std::string p = "localisation_error.";
+    if (l["bias"]) e.bias = toPoint(l["bias"], p + "bias");
+    e.bias_yaw_deg = get<double>(l, "bias_yaw_deg", p, e.bias_yaw_deg);
+    e.random_walk = get<double>(l, "random_walk", p, e.random_walk);
+    e.random_walk_time = get<double>(l, "random_walk_time", p, e.random_walk_time);
+    e.white_noise = get<double>(l, "white_noise", p, e.white_noise);
+    e.reported_sigma = get<double>(l, "reported_sigma", p, e.reported_sigma);
+    e.covariance_rate_hz = get<double>(l, "covariance_rate_hz", p, e.covariance_rate_hz);
   }
 
   if (const YAML::Node objects = root["objects"])

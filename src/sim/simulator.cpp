@@ -65,6 +65,16 @@ Simulator::Simulator(Scenario scenario, const core::VectorMap& map) : scenario_(
   scenario_.validate();
   const MapErrors& errors = scenario_.map_errors;
   std::vector<bool> absent_point_used(errors.absent_at.size(), false);
+  std::vector<bool> offset_used(errors.offsets.size(), false);
+  const double rot = errors.rotation_deg * kDegToRad, cr = std::cos(rot), sr = std::sin(rot);
+  const auto realPlace = [&](core::Polygon& poly, Point2 extra) {
+    auto move = [&](core::Ring& ring) {
+      for (Point2& p : ring)
+        p = Point2{ cr * p.x - sr * p.y + errors.shift.x + extra.x, sr * p.x + cr * p.y + errors.shift.y + extra.y };
+    };
+    move(poly.outer);
+    for (core::Ring& h : poly.holes) move(h);
+  };
   std::vector<bool> absent_id_used(errors.absent_ids.size(), false);
   std::vector<WorldBuilding> world;
   for (const core::Building& b : map.buildings)
@@ -89,6 +99,17 @@ Simulator::Simulator(Scenario scenario, const core::VectorMap& map) : scenario_(
     }
     WorldBuilding w;
     w.footprint = b.footprint;
+    Point2 extra;
+    for (std::size_t i = 0; i < errors.offsets.size(); ++i)
+    {
+      const BuildingOffset& o = errors.offsets[i];
+      const bool hit = std::isnan(o.at.x) ? (!b.id.empty() && b.id == o.id) : insidePolygon(b.footprint, o.at);
+      if (!hit) continue;
+      offset_used[i] = true;
+      extra.x += o.offset.x;
+      extra.y += o.offset.y;
+    }
+    realPlace(w.footprint, extra);
     w.height = b.height > 0.0 ? b.height : scenario_.default_building_height;
     w.cell_class = core::CellClass::kBuilding;
     w.id = b.id;
@@ -103,6 +124,25 @@ Simulator::Simulator(Scenario scenario, const core::VectorMap& map) : scenario_(
   for (std::size_t i = 0; i < absent_id_used.size(); ++i)
     if (!absent_id_used[i])
       throw core::ParameterError("map_errors.absent_buildings", "no map building has id '" + errors.absent_ids[i] + "'");
+  for (std::size_t i = 0; i < offset_used.size(); ++i)
+    if (!offset_used[i])
+      throw core::ParameterError("map_errors.offset_buildings",
+                                 "no map building matches entry " + std::to_string(i) + " (at or id)");
+  const LocalisationError& le = scenario_.localisation_error;
+  if (le.random_walk > 0.0)
+  {
+    const double dt = 1.0 / scenario_.tf_rate_hz;
+    const double a = std::exp(-dt / le.random_walk_time), b = le.random_walk * std::sqrt(1.0 - a * a);
+    Rng rng(scenario_.seed * 0xA0761D6478BD642FULL + 17);
+    Point2 e{ le.random_walk * rng.gaussian(), le.random_walk * rng.gaussian() };
+    const std::size_t n = static_cast<std::size_t>(std::ceil(scenario_.duration / dt)) + 2;
+    walk_.reserve(n);
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      walk_.push_back(e);
+      e = Point2{ a * e.x + b * rng.gaussian(), a * e.y + b * rng.gaussian() };
+    }
+  }
   for (WorldBuilding w : errors.unmapped)
   {
     w.cell_class = core::CellClass::kInfrastructure;
@@ -140,6 +180,30 @@ Pose2 Simulator::egoPose(double t) const
 {
   const MotionState st = ego_motion_->at(t);
   return Pose2{ st.x, st.y, st.yaw };
+}
+
+Pose2 Simulator::reportedEgoPose(double t) const
+{
+  Pose2 p = egoPose(t);
+  const LocalisationError& le = scenario_.localisation_error;
+  if (!le.any()) return p;
+  const long k = std::max(0L, std::lround(t * scenario_.tf_rate_hz));
+  p.x += le.bias.x;
+  p.y += le.bias.y;
+  p.yaw += le.bias_yaw_deg * kDegToRad;
+  if (!walk_.empty())
+  {
+    const Point2& w = walk_[std::min(static_cast<std::size_t>(k), walk_.size() - 1)];
+    p.x += w.x;
+    p.y += w.y;
+  }
+  if (le.white_noise > 0.0)
+  {
+    Rng rng(scenario_.seed * 0xE7037ED1A0B428DBULL ^ (static_cast<std::uint64_t>(k) + 1) * 0x8EBC6AF09C88C6E3ULL);
+    p.x += le.white_noise * rng.gaussian();
+    p.y += le.white_noise * rng.gaussian();
+  }
+  return p;
 }
 
 double Simulator::egoSpeed(double t) const { return ego_motion_->at(t).speed; }

@@ -61,6 +61,7 @@ struct Options
   std::string fusion_config;
   std::string scan_grid_config;
   std::string prior_config;
+  std::optional<std::string> pose_covariance_topic;  ///< replaces the fusion config's
   std::string map;
   std::optional<std::array<double, 3>> origin;
   std::string base_frame = "base_link";
@@ -76,6 +77,7 @@ void usage()
 {
   std::cerr << "usage: evaluate --bag SCENARIO.bag [--output-bag LIVE.bag] [--out DIR]\n"
                "                [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
+               "                [--pose-covariance-topic T] (softens the prior by the sigma of T)\n"
                "                [--map FILE] [--origin LAT,LON[,ALT]] [--snapshot-time S] [--sheet-period S]\n"
                "                [--match-radius M] [--no-ablations] [--quiet]\n"
                "  Runs the pipeline offline on the bag with the configured method (variant `default`), the\n"
@@ -244,6 +246,7 @@ Options parse(int argc, char** argv)
     else if (a == "--snapshot-time") o.snapshot_time = argDouble(a, value());
     else if (a == "--sheet-period") o.sheet_period = argDouble(a, value());
     else if (a == "--match-radius") o.match_radius = argDouble(a, value());
+    else if (a == "--pose-covariance-topic") o.pose_covariance_topic = value();
     else if (a == "--no-ablations") o.ablations = false;
     else if (a == "--quiet") o.quiet = true;
     else if (a == "-h" || a == "--help")
@@ -349,6 +352,7 @@ int main(int argc, char** argv)
     std::string covariance_topic, covariance_type = "pose";
     if (fusion_cfg["pose_covariance_topic"]) covariance_topic = fusion_cfg["pose_covariance_topic"].as<std::string>();
     if (fusion_cfg["pose_covariance_type"]) covariance_type = fusion_cfg["pose_covariance_type"].as<std::string>();
+    if (opt.pose_covariance_topic) covariance_topic = *opt.pose_covariance_topic;
     std::map<std::int64_t, double> covariance_sigma;
     std::size_t covariance_rejected = 0;
 

@@ -35,6 +35,8 @@ struct SimBagNames
   std::string tf_static_topic = "/tf_static";
   std::string classes_topic = "/ground_truth/classes";
   std::string objects_topic = "/ground_truth/objects";
+  /// geometry_msgs/PoseWithCovarianceStamped of the localisation (only when the scenario has a localisation error)
+  std::string pose_topic = "/localisation/pose";
   std::string map_frame = "map";
   std::string base_frame = "base_link";
   std::string lidar_frame = "lidar";

@@ -45,12 +45,44 @@ struct EgoSpec
   MotionParams motion;
 };
 
+/// A mapped building that stands elsewhere in the real world.
+struct BuildingOffset
+{
+  Point2 at{ std::numeric_limits<double>::quiet_NaN(), 0.0 };  ///< a point inside it (NaN: use id)
+  std::string id;                                               ///< or its map id
+  Point2 offset;                                                ///< real position − mapped position, metres
+};
+
 /// Differences between the real world and the map.
 struct MapErrors
 {
   std::vector<WorldBuilding> unmapped;     ///< real buildings that the map lacks (ground truth N)
   std::vector<Point2> absent_at;           ///< mapped buildings, found by a point inside, that are not there
   std::vector<std::string> absent_ids;     ///< mapped buildings, by map id, that are not there
+  /// The whole map is off: the real buildings are the mapped ones rotated by rotation_deg about the map origin,
+  /// then shifted by shift (metres).
+  Point2 shift;
+  double rotation_deg = 0.0;
+  std::vector<BuildingOffset> offsets;     ///< single buildings off by their own offset (after the whole-map error)
+};
+
+/**
+ * @brief What the localisation publishes beyond the truth: the tf map → base_link carries the true pose plus
+ *        bias + random walk + white noise; the ground truth does not. Also a pose covariance topic.
+ */
+struct LocalisationError
+{
+  Point2 bias;                 ///< constant position error, metres
+  double bias_yaw_deg = 0.0;   ///< constant heading error, degrees
+  double random_walk = 0.0;    ///< stationary σ of a slow random walk per axis (Ornstein–Uhlenbeck), metres
+  double random_walk_time = 10.0;  ///< its correlation time, s (> 0)
+  double white_noise = 0.0;    ///< σ of independent noise on each published pose, per axis, metres
+  /// σ the localisation reports in its covariance, metres; < 0: sqrt(|bias|² + random_walk² + white_noise²).
+  double reported_sigma = -1.0;
+  double covariance_rate_hz = 10.0;  ///< rate of the covariance topic (> 0)
+  bool any() const { return bias.x != 0.0 || bias.y != 0.0 || bias_yaw_deg != 0.0 || random_walk > 0.0 || white_noise > 0.0; }
+  /// The σ published in the covariance.
+  double reportedSigma() const;
 };
 
 /// Ground-truth raster parameters.
@@ -85,6 +117,7 @@ struct Scenario
   EgoSpec ego;
   std::vector<ObjectSpec> objects;
   MapErrors map_errors;
+  LocalisationError localisation_error;
   GroundTruthParams ground_truth;
   SceneParams scene;
 
@@ -96,7 +129,8 @@ struct Scenario
 bool objectKindDefaults(const std::string& kind, ObjectSpec& spec);
 
 /**
- * @brief Parses a scenario from YAML text. Relative file names (map) are resolved against @p base_dir.
+ * @brief Parses a scenario from YAML text. Relative file names (map, base) are resolved against @p base_dir.
+ *        `base: other.yaml` loads that scenario first; this file's top-level keys then replace its keys.
  * @throws core::ParameterError naming the offending key (YAML syntax errors are reported as key "yaml").
  */
 Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir);

@@ -103,6 +103,8 @@ public:
 
   /// Pose of base_link in the map frame at time @p t.
   Pose2 egoPose(double t) const;
+  /// The pose the localisation publishes at time @p t: egoPose(t) plus the scenario's localisation error.
+  Pose2 reportedEgoPose(double t) const;
   /// Ego speed (m/s) at time @p t.
   double egoSpeed(double t) const;
   /// Pose of the lidar in the map frame for an ego pose.
@@ -126,6 +128,7 @@ private:
   std::vector<BeamHit> hits_;
   std::vector<std::uint8_t> observed_;
   std::vector<WorldObject> solids_;
+  std::vector<Point2> walk_;  ///< random walk of the localisation error, one sample per tf period
 };
 
 }  // namespace sim
