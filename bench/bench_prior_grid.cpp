@@ -85,7 +85,8 @@ void BM_PriorFillWindow(benchmark::State& state)
 {
   if (!haveMonaco(state)) return;
   const core::VectorMap m = map_io::loadVectorMap(monacoParams());
-  const core::PriorGrid grid = core::PriorGrid::fromVectorMap(m, kResolution);
+  const core::PriorCellTest test = state.range(1) != 0 ? core::PriorCellTest::kCoverage : core::PriorCellTest::kCentre;
+  const core::PriorGrid grid = core::PriorGrid::fromVectorMap(m, kResolution, 0.0, nullptr, test);
   const bool aligned = state.range(0) != 0;
   const double offset = aligned ? 0.0 : 0.13;  // unaligned: per-cell centre sampling
   const core::GridGeometry w = core::GridGeometry::centred(100.0, 100.0, kResolution, offset, offset);
@@ -98,6 +99,7 @@ void BM_PriorFillWindow(benchmark::State& state)
   }
   state.counters["cells"] = static_cast<double>(w.numCells());
 }
-BENCHMARK(BM_PriorFillWindow)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+// Args: {aligned, cell test (0 centre, 1 coverage)}.
+BENCHMARK(BM_PriorFillWindow)->Args({ 1, 0 })->Args({ 0, 0 })->Args({ 1, 1 })->Args({ 0, 1 })->Unit(benchmark::kMicrosecond);
 
 }  // namespace
