@@ -14,7 +14,7 @@ namespace {
 using map_aided_fusion::EvidentialGrid;
 
 constexpr double kTimeout = 30.0;  // s
-constexpr std::uint8_t kB = 0b00010, kR = 0b11001, kT = 0b11101, kOmega = 0b11111;  // bits F C N S V
+constexpr std::uint8_t kB = 0b00010, kR = 0b11001, kT = 0b11101, kOmega = 0b11111, kW = 0b00011;  // bits F C N S V
 
 template <class M>
 boost::shared_ptr<const M> waitFor(const std::string& topic, double timeout = kTimeout)
@@ -41,9 +41,10 @@ TEST(PriorGridNodelet, LateSubscriberReceivesTheLatchedPrior)
   EXPECT_EQ(g->header.frame_id, "map");
   EXPECT_FLOAT_EQ(g->info.resolution, 0.5f);
   ASSERT_EQ(g->classes.size(), 5u);
-  ASSERT_EQ(g->focal_sets, (std::vector<std::uint8_t>{ kB, kR, kT, kOmega }));
+  // cell_test: coverage adds the outline focal set W = {F, C}.
+  ASSERT_EQ(g->focal_sets, (std::vector<std::uint8_t>{ kB, kR, kT, kOmega, kW }));
   const std::size_t n = static_cast<std::size_t>(g->info.width) * g->info.height;
-  ASSERT_EQ(g->masses.size(), 4 * n);
+  ASSERT_EQ(g->masses.size(), 5 * n);
   // The town (maps/README.md): about 310 m × 310 m at 0.5 m.
   EXPECT_GT(g->info.width, 600u);
   EXPECT_LT(g->info.width, 640u);
@@ -52,7 +53,8 @@ TEST(PriorGridNodelet, LateSubscriberReceivesTheLatchedPrior)
   EXPECT_NEAR(massAt(*g, kR, -80.0, 50.0), 0.9, 1e-6);  // West Avenue
   EXPECT_NEAR(massAt(*g, kOmega, -80.0, 50.0), 0.1, 1e-6);
   for (std::size_t i = 0; i < n; i += 97)
-    EXPECT_NEAR(g->masses[i] + g->masses[n + i] + g->masses[2 * n + i] + g->masses[3 * n + i], 1.0, 1e-6);
+    EXPECT_NEAR(g->masses[i] + g->masses[n + i] + g->masses[2 * n + i] + g->masses[3 * n + i] + g->masses[4 * n + i],
+                1.0, 1e-6);
 
   const auto occ = waitFor<nav_msgs::OccupancyGrid>("/prior_grid/occupancy");
   ASSERT_TRUE(occ != nullptr);
