@@ -520,6 +520,24 @@ void MapGrid::shift(int dx, int dy)
   if (map_doubt_.size() == g.numCells()) shiftPlane(map_doubt_.data(), g, dx, dy, 0.0f);
 }
 
+void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow& prior, std::vector<std::int8_t>& out)
+{
+  constexpr std::int8_t kNavigableRoad = 0, kNotNavigable = 100, kUnknownSpace = -1;
+  out.resize(decision.size());
+  const bool has_prior = prior.road.size() == decision.size();
+  for (std::size_t i = 0; i < decision.size(); ++i)
+  {
+    const auto d = static_cast<CellClass>(decision[i]);
+    if (d == CellClass::kUnknown)
+      out[i] = kUnknownSpace;
+    else if (d != CellClass::kFree)
+      out[i] = kNotNavigable;
+    else
+      out[i] = has_prior && prior.road[i] > prior.other[i] + prior.building[i] + prior.wall[i] ? kNavigableRoad
+                                                                                                : kNavigableOffRoad;
+  }
+}
+
 void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt)
 {
   const std::size_t n = prior.geometry.numCells();

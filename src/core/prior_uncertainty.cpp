@@ -4,7 +4,6 @@
 #include <cmath>
 #include <vector>
 
-#include "map_aided_fusion/core/cell_class.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
 
 namespace map_aided_fusion {
@@ -126,24 +125,6 @@ CovarianceFault positionSigma(const std::array<double, 36>& c, double& sigma)
   const double mean = 0.5 * (xx + yy), dev = std::sqrt(0.25 * (xx - yy) * (xx - yy) + xy * xy);
   sigma = std::sqrt(std::max(0.0, mean + dev));
   return CovarianceFault::kNone;
-}
-
-void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow& prior, std::vector<std::int8_t>& out)
-{
-  constexpr std::int8_t kNavigableRoad = 0, kNotNavigable = 100, kUnknownSpace = -1;
-  out.resize(decision.size());
-  const bool has_prior = prior.road.size() == decision.size();
-  for (std::size_t i = 0; i < decision.size(); ++i)
-  {
-    const auto d = static_cast<CellClass>(decision[i]);
-    if (d == CellClass::kUnknown)
-      out[i] = kUnknownSpace;
-    else if (d != CellClass::kFree)
-      out[i] = kNotNavigable;
-    else
-      out[i] = has_prior && prior.road[i] > prior.other[i] + prior.building[i] + prior.wall[i] ? kNavigableRoad
-                                                                                                : kNavigableOffRoad;
-  }
 }
 
 void PriorGridOptions::validate() const

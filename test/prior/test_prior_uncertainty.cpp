@@ -260,7 +260,7 @@ TEST(MapConflict, ABuildingSeenThroughLosesItsPriorAndAWallSeenKeepsIt)
   EXPECT_EQ(last, 1.0f);
 }
 
-TEST(MapConflict, TheWallFocalSetDecidesOccupiedAsBuildingAndFreeAsFree)
+TEST(WallFocalSet, DecidesOccupiedAsBuildingAndFreeAsFree)
 {
   FusionParams params;
   MassMG prior{ { FrameMG::kWall, 0.9 }, { FrameMG::kOmega, 0.1 } };

@@ -189,6 +189,17 @@ void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const Gr
 void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out);
 
 /**
+ * @brief The navigable-space layer (nav_msgs/OccupancyGrid values) from a decision grid and the prior of the same
+ *        cells: free on the road surface (m_PG(R) above m_PG(T) + m_PG(B) + m_PG(W)) → 0; free elsewhere or where
+ *        the prior is vacuous → kNavigableOffRoad; occupied (C, N, S, V, or occupied undetermined) → 100;
+ *        undecided → −1.
+ */
+void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow& prior, std::vector<std::int8_t>& out);
+
+/// Value of free space off the road surface in the navigable layer.
+constexpr std::int8_t kNavigableOffRoad = 50;
+
+/**
  * @brief Step map_conflict (MapGridParams::map_conflict_gain): updates the doubt η of each cell from the scan
  *        @p scan (same geometry) and discounts @p prior by it in place. @p doubt is resized (zeros) when needed.
  */

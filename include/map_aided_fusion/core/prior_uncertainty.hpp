@@ -14,9 +14,7 @@
 #pragma once
 
 #include <array>
-#include <cstdint>
 #include <memory>
-#include <vector>
 
 #include "map_aided_fusion/core/mass_grid.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
@@ -45,17 +43,6 @@ const char* toString(CovarianceFault f);
  *        matrix is checked. The yaw variance is not used. @p sigma is left unchanged on a fault.
  */
 CovarianceFault positionSigma(const std::array<double, 36>& covariance, double& sigma);
-
-/**
- * @brief The navigable-space layer (nav_msgs/OccupancyGrid values) from a decision grid and the prior of the same
- *        cells: free on the road surface (m_PG(R) above m_PG(T) + m_PG(B) + m_PG(W)) → 0; free elsewhere or where
- *        the prior is vacuous → kNavigableOffRoad; occupied (C, N, S, V, or occupied undetermined) → 100;
- *        undecided → −1.
- */
-void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow& prior, std::vector<std::int8_t>& out);
-
-/// Value of free space off the road surface in the navigable layer.
-constexpr std::int8_t kNavigableOffRoad = 50;
 
 /**
  * @brief @p out ← @p in softened by σ_building (B and W) and σ_road (R and T), metres in [0, kMaxPositionSigma].
