@@ -1,4 +1,5 @@
-// ScanGrid construction: a 64-beam-like cloud into a 160 m × 160 m grid at 0.2 m (BM_ScanGrid/N), the
+// ScanGrid construction: a 64-beam-like cloud into a 160 m × 160 m grid at 0.2 m (BM_ScanGrid/N; with the
+// `planes` ground model BM_ScanGridGround/N; its deskewing at 15 m/s BM_Deskew/N), the
 // paper's IBEO Alaska XT case (4 layers, ~800 points, 0.5 m cells; BM_ScanGridPaper/N), and the one-off
 // cost of the geometry table (BM_ScanGridTable).
 #include <benchmark/benchmark.h>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <vector>
 
+#include "map_aided_fusion/core/deskew.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 
 using namespace map_aided_fusion::core;
@@ -16,6 +18,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kVelodyneStep = 22;  // x y z intensity (float32), ring (uint16), time (float32)
+constexpr std::size_t kTimeOffset = 18;
+constexpr double kSweepPeriod = 0.1;  // s, a 10 Hz spin: each column's time
+constexpr double kSweepSpeed = 15.0;  // m/s, the ego's speed in BM_Deskew
 
 struct Ray
 {
@@ -64,6 +69,8 @@ std::vector<std::uint8_t> makeCloud(std::size_t n, int beams, double lo_deg, dou
     std::memcpy(buf.data() + i * kVelodyneStep, xyz, sizeof xyz);
     const std::uint16_t ring = static_cast<std::uint16_t>(beam);
     std::memcpy(buf.data() + i * kVelodyneStep + 16, &ring, sizeof ring);
+    const float time = static_cast<float>(kSweepPeriod * static_cast<double>(column) / static_cast<double>(columns));
+    std::memcpy(buf.data() + i * kVelodyneStep + kTimeOffset, &time, sizeof time);
   }
   return buf;
 }
@@ -104,6 +111,48 @@ void BM_ScanGrid(benchmark::State& state)
   state.counters["points/s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_ScanGrid)->Arg(0)->Arg(130000)->Arg(260000)->Unit(benchmark::kMillisecond);
+
+void BM_ScanGridGround(benchmark::State& state)
+{
+  const std::size_t n = static_cast<std::size_t>(state.range(0));
+  const double h = 1.8;
+  const auto cloud = makeCloud(n, 64, -25.0, 15.0, -kPi, 2.0 * kPi, h);
+  ScanGridParams p = spinningParams();
+  p.ground_model = "planes";
+  ScanGridBuilder builder(p, sensorAt(0.9, h));
+  ScanMassGrid grid(builder.geometry());
+  ScanGridStats st;
+  const PointCloudView v = PointCloudView::packed(cloud.data(), n, kVelodyneStep);
+  for (auto _ : state)
+  {
+    builder.build(v, grid, &st);
+    benchmark::DoNotOptimize(grid.plane(FrameSG::kO));
+  }
+  state.counters["occupied"] = static_cast<double>(st.occupied_cells);
+  state.counters["zones_fitted"] = static_cast<double>(st.ground_fit.fitted);
+}
+BENCHMARK(BM_ScanGridGround)->Arg(130000)->Unit(benchmark::kMillisecond);
+
+void BM_Deskew(benchmark::State& state)
+{
+  const std::size_t n = static_cast<std::size_t>(state.range(0));
+  const auto cloud = makeCloud(n, 64, -25.0, 15.0, -kPi, 2.0 * kPi, 1.8);
+  const PointCloudView v = PointCloudView::packed(cloud.data(), n, kVelodyneStep);
+  const PointTimeField time{ kTimeOffset, TimeEncoding::kFloat32, 1.0, false, "time" };
+  SweepMotion motion;
+  motion.delta = Eigen::Isometry3d(Eigen::Translation3d(kSweepSpeed * kSweepPeriod, 0.0, 0.0)) *
+                 Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ());
+  motion.duration = kSweepPeriod;
+  std::vector<float> out;
+  PointCloudView deskewed;
+  for (auto _ : state)
+  {
+    benchmark::DoNotOptimize(deskew(v, time, 0.0, motion, 2.0 * kSweepPeriod, out, deskewed));
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["points/s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_Deskew)->Arg(130000)->Unit(benchmark::kMillisecond);
 
 void BM_ScanGridPaper(benchmark::State& state)
 {

@@ -17,8 +17,8 @@ install(TARGETS map_aided_fusion_dataset map_aided_fusion_dataset_ros kitti_to_b
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
-  catkin_add_gtest(test_dataset test/dataset/test_kitti.cpp test/test_main.cpp)
-  target_link_libraries(test_dataset map_aided_fusion_dataset_ros)
+  catkin_add_gtest(test_dataset test/dataset/test_kitti.cpp test/dataset/test_kitti_ground.cpp test/test_main.cpp)
+  target_link_libraries(test_dataset map_aided_fusion_dataset_ros map_aided_fusion_core)
   target_compile_definitions(test_dataset PRIVATE MAF_SHARED_DATA_DIR="${CMAKE_CURRENT_SOURCE_DIR}/../shared/data"
     MAF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
   add_dependencies(tests kitti_to_bag)

@@ -23,6 +23,7 @@ MAF_DEB_PACKAGES=(
   ros-std-msgs ros-nav-msgs ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-std-srvs
   libeigen3-dev libgeographiclib-dev libgdal-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev
+  libpcl-dev libpcl-ros-dev libpcl-ros-filters0d libpcl-ros-filter1d tf2-tools
 )
 
 maf_log() { printf '\033[1m[map_aided_fusion]\033[0m %s\n' "$*" >&2; }

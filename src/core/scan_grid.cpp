@@ -22,6 +22,11 @@ constexpr double kMaxExtent = 10000.0;       // m
 constexpr double kMinGridResolution = 0.01;  // m
 constexpr double kMaxSensorOffset = 1000.0;  // m
 constexpr double kSensorMoveTolerance = 1e-3;  // m; a smaller (x, y) change keeps the table
+constexpr double kMaxSweepDuration = 10.0;     // s
+constexpr int kMaxGroundSectors = 64;
+constexpr double kMaxGroundSlopeDeg = 60.0;
+constexpr int kMaxGroundMinPoints = 100000;
+constexpr double kMaxGroundBand = 10.0;  // m
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kHalfPi = 0.5f * kPi;
 constexpr float kTwoPi = 2.0f * kPi;
@@ -91,6 +96,16 @@ void ScanGridParams::validate() const
   requireInRange("free_decay_length", free_decay_length, 0.0, kMaxExtent);
   requireInRange("free_margin", free_margin, 0.0, max_range);
   requireInRange("relative_height_limit", relative_height_limit, 0.0, kMaxExtent);
+  if (!(deskew_max_sweep_duration > 0.0)) throw ParameterError("deskew_max_sweep_duration", "must be > 0");
+  requireInRange("deskew_max_sweep_duration", deskew_max_sweep_duration, 0.0, kMaxSweepDuration);
+  groundModel();
+  requireInRange("ground_sectors", ground_sectors, 1, kMaxGroundSectors);
+  requireInRange("ground_max_slope_deg", ground_max_slope_deg, 0.0, kMaxGroundSlopeDeg);
+  requireInRange("ground_min_points", ground_min_points, 3, kMaxGroundMinPoints);
+  if (!(ground_search_band > 0.0)) throw ParameterError("ground_search_band", "must be > 0");
+  requireInRange("ground_search_band", ground_search_band, 0.0, kMaxGroundBand);
+  if (!(ground_fit_tolerance > 0.0)) throw ParameterError("ground_fit_tolerance", "must be > 0");
+  requireInRange("ground_fit_tolerance", ground_fit_tolerance, 0.0, ground_search_band);
   const double cells = std::round(grid_size_x / grid_resolution) * std::round(grid_size_y / grid_resolution);
   if (!(cells <= static_cast<double>(kScanGridMaxCells)))
     throw ParameterError("grid_size_x", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
@@ -149,6 +164,8 @@ void ScanGridBuilder::configure(const ScanGridParams& params, const Eigen::Isome
   geometry_ = geometry;
   sensor_pose_ = sensor_pose;
   configured_ = true;
+  ground_kind_ = params.groundModel();
+  ground_.configure(params.groundModelParams());
   if (!same_table) buildTable();
 }
 
@@ -227,7 +244,6 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   }
   if (obstacle_points_.size() < 2 * (n_points + 1)) obstacle_points_.resize(2 * (n_points + 1));
   const bool relative = params_.relative_height_limit > 0.0;
-  const float relative_below = static_cast<float>(params_.ground_height + params_.relative_height_limit);
   if (relative)
   {
     if (obstacle_z_.size() < n_points + 1) obstacle_z_.resize(n_points + 1);
@@ -243,10 +259,6 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float shift_y = static_cast<float>(sensor_pose_.translation().y() - table_sensor_y_);
   const float trans_z = static_cast<float>(sensor_pose_.translation().z());
   const float ground = static_cast<float>(params_.ground_height);
-  const float ground_lo = ground - static_cast<float>(params_.ground_tolerance);
-  const float ground_hi = ground + static_cast<float>(params_.ground_tolerance);
-  const float obstacle_lo = ground + static_cast<float>(params_.obstacle_min_height);
-  const float obstacle_hi = ground + static_cast<float>(params_.obstacle_max_height);
   const float min2 = static_cast<float>(params_.min_range * params_.min_range);
   const float max2 = static_cast<float>(params_.max_range * params_.max_range);
   const float inv_res = static_cast<float>(1.0 / geometry_.resolution);
@@ -269,7 +281,8 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const std::size_t row_step = points.row_step;
   const std::size_t x_offset = points.x_offset, y_offset = points.y_offset, z_offset = points.z_offset;
 
-  // Pass 1: classify every point and compact the ground and obstacle returns.
+  // Pass 1: classify every point and compact the ground and obstacle returns. With the `planes` ground model the
+  // valid returns are first kept with their zones, the model fitted, and then they are classified.
   std::size_t n_ground = 0, n_obstacle = 0;
   std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, self = 0;
   std::size_t below_ground = 0, gap = 0, above = 0;
@@ -278,6 +291,70 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float self_max_x = static_cast<float>(params_.self_box_max_x - table_sensor_x_);
   const float self_min_y = static_cast<float>(params_.self_box_min_y - table_sensor_y_);
   const float self_max_y = static_cast<float>(params_.self_box_max_y - table_sensor_y_);
+  const float tolerance = static_cast<float>(params_.ground_tolerance);
+  const float obstacle_min = static_cast<float>(params_.obstacle_min_height);
+  const float obstacle_max = static_cast<float>(params_.obstacle_max_height);
+  const float relative_limit = static_cast<float>(params_.relative_height_limit);
+  // Classifies a valid return at (dx, dy) from the sensor, height z, over ground height g.
+  // sector < 0: not known yet, computed here when needed.
+  const auto classify = [&](float dx, float dy, float z, float r2, float g, int sector) {
+    if (relative)
+    {
+      const float fx = cx0 + dx * inv_res;
+      const float fy = cy0 + dy * inv_res;
+      if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
+      {
+        float& lowest = cell_min_z[static_cast<int>(fy) * width + static_cast<int>(fx)];
+        lowest = std::min(lowest, z);
+      }
+    }
+    const float h = z - g;
+    if (h < -tolerance)
+    {
+      ++below_ground;
+    }
+    else if (h <= tolerance)
+    {
+      ground_sector[n_ground] =
+          static_cast<std::uint32_t>(sector >= 0 ? sector : sectorIndex(dx, dy, sector_scale, num_sectors));
+      ground_range2[n_ground] = r2;
+      ++n_ground;
+    }
+    else if (h < obstacle_min)
+    {
+      ++gap;
+    }
+    else if (h <= obstacle_max)
+    {
+      const float fx = cx0 + dx * inv_res;
+      const float fy = cy0 + dy * inv_res;
+      const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
+      obstacle_sector[n_obstacle] =
+          static_cast<std::uint32_t>(sector >= 0 ? sector : sectorIndex(dx, dy, sector_scale, num_sectors));
+      obstacle_range2[n_obstacle] = r2;
+      obstacle_cell[n_obstacle] =
+          inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
+      obstacle_xy[2 * n_obstacle] = dx;
+      obstacle_xy[2 * n_obstacle + 1] = dy;
+      if (relative) obstacle_z[n_obstacle] = h < relative_limit ? z : kInfinity;
+      ++n_obstacle;
+    }
+    else
+    {
+      ++above;
+    }
+  };
+  const bool planes = ground_kind_ == GroundModel::kPlanes;
+  std::size_t n_valid = 0;
+  if (planes && valid_dx_.size() < n_points)
+  {
+    valid_dx_.resize(n_points);
+    valid_dy_.resize(n_points);
+    valid_z_.resize(n_points);
+    valid_zone_.resize(n_points);
+    valid_sector_.resize(n_points);
+  }
+  const float inv_sectors = 1.0f / static_cast<float>(num_sectors);
   for (std::size_t row = 0; row < rows; ++row)
   {
     const std::uint8_t* p = data + row * row_step;
@@ -315,48 +392,28 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         ++self;
         continue;
       }
-      if (relative)
+      if (planes)
       {
-        const float fx = cx0 + dx * inv_res;
-        const float fy = cy0 + dy * inv_res;
-        if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
-        {
-          float& lowest = cell_min_z[static_cast<int>(fy) * width + static_cast<int>(fx)];
-          lowest = std::min(lowest, z);
-        }
+        valid_dx_[n_valid] = dx;
+        valid_dy_[n_valid] = dy;
+        valid_z_[n_valid] = z;
+        const int sector = sectorIndex(dx, dy, sector_scale, num_sectors);
+        valid_sector_[n_valid] = static_cast<std::uint32_t>(sector);
+        valid_zone_[n_valid] = static_cast<std::uint16_t>(ground_.zoneOf(r2, static_cast<float>(sector) * inv_sectors));
+        ++n_valid;
+        continue;
       }
-      if (z < ground_lo)
-      {
-        ++below_ground;
-      }
-      else if (z <= ground_hi)
-      {
-        ground_sector[n_ground] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
-        ground_range2[n_ground] = r2;
-        ++n_ground;
-      }
-      else if (z < obstacle_lo)
-      {
-        ++gap;
-      }
-      else if (z <= obstacle_hi)
-      {
-        const float fx = cx0 + dx * inv_res;
-        const float fy = cy0 + dy * inv_res;
-        const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
-        obstacle_sector[n_obstacle] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
-        obstacle_range2[n_obstacle] = r2;
-        obstacle_cell[n_obstacle] =
-            inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
-        obstacle_xy[2 * n_obstacle] = dx;
-        obstacle_xy[2 * n_obstacle + 1] = dy;
-        if (relative) obstacle_z[n_obstacle] = z;
-        ++n_obstacle;
-      }
-      else
-      {
-        ++above;
-      }
+      classify(dx, dy, z, r2, ground, -1);
+    }
+  }
+  if (planes)
+  {
+    st.ground_fit = ground_.fit(valid_dx_.data(), valid_dy_.data(), valid_z_.data(), valid_zone_.data(), n_valid);
+    for (std::size_t i = 0; i < n_valid; ++i)
+    {
+      const float dx = valid_dx_[i], dy = valid_dy_[i];
+      classify(dx, dy, valid_z_[i], dx * dx + dy * dy, ground_.plane(valid_zone_[i]).at(dx, dy),
+               static_cast<int>(valid_sector_[i]));
     }
   }
   std::size_t low_relief = 0;
@@ -369,7 +426,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     for (std::size_t k = 0; k < n_obstacle; ++k)
     {
       const std::uint32_t cell = obstacle_cell[k];
-      if (cell != kOutside && obstacle_z[k] < relative_below)
+      if (cell != kOutside && obstacle_z[k] < kInfinity)
       {
         const int x = static_cast<int>(cell % static_cast<std::uint32_t>(width));
         const int y = static_cast<int>(cell / static_cast<std::uint32_t>(width));

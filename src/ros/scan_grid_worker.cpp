@@ -44,6 +44,8 @@ void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
   c.mu_occupied = m.mu_occupied;
   c.free_decay_length = m.free_decay_length;
   c.free_margin = m.free_margin;
+  c.deskew = m.deskew;
+  c.ground_model = m.ground_model;
 }
 
 Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
@@ -59,6 +61,11 @@ Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
 void ScanGridNodeParams::validate() const
 {
   if (base_frame.empty()) throw core::ParameterError("base_frame", "must not be empty");
+  if (deskew_fixed_frame.empty()) throw core::ParameterError("deskew_fixed_frame", "must not be empty");
+  const auto& known = knownTimeFields();
+  if (deskew_time_field != "auto" && std::find(known.begin(), known.end(), deskew_time_field) == known.end())
+    throw core::ParameterError("deskew_time_field", "unknown field '" + deskew_time_field +
+                                                        "' (auto, time, t, timestamp, offset_time)");
   core::requireInRange("input_queue_size", input_queue_size, 1, kMaxQueueSize);
   core::requireInRange("tf_queue_size", tf_queue_size, 1, kMaxQueueSize);
   core::requireInRange("future_tolerance", future_tolerance, 0.0, kMaxFutureTolerance);
@@ -75,6 +82,8 @@ ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "tf_queue_size", p.tf_queue_size);
   readParam(pnh, "future_tolerance", p.future_tolerance);
   readParam(pnh, "time_jump_threshold", p.time_jump_threshold);
+  readParam(pnh, "deskew_fixed_frame", p.deskew_fixed_frame);
+  readParam(pnh, "deskew_time_field", p.deskew_time_field);
   core::forEachParam(p.health, parameterServerReader(pnh));
   core::forEachParam(p.model, parameterServerReader(pnh));
   p.validate();
@@ -108,7 +117,9 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   updater_->setHardwareID("scan_grid");
   updater_->add("ScanGrid", this, &ScanGridWorker::diagnose);
-  for (auto* w : { &received_window_, &published_window_, &rejected_window_ }) w->setSpan(params_.health.diagnostic_window);
+  for (auto* w : { &received_window_, &published_window_, &rejected_window_, &deskew_skipped_window_,
+                   &ground_fallback_window_ })
+    w->setSpan(params_.health.diagnostic_window);
   start_wall_ = core::steadySeconds();
   clock_jump_.setThreshold(params_.time_jump_threshold);
   diagnostic_timer_ = nh_.createWallTimer(ros::WallDuration(params_.health.diagnostic_period),
@@ -252,14 +263,36 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
     reject("bad_transform", e.what());
     return;
   }
-  core::PointCloudView view;
-  if (!viewOf(*cloud, view)) return;
+  core::PointCloudView raw, view;
+  if (!viewOf(*cloud, raw)) return;
+  const DeskewResult deskew =
+      deskewer_.apply(*cloud, raw, params_.model.deskew, params_.deskew_time_field,
+                      params_.model.deskew_max_sweep_duration, *tf_buffer_, params_.deskew_fixed_frame, view);
+  ++deskew_counts_[deskew.status];
+  last_deskew_ = deskew.status;
+  if (!deskew.applied && deskew.status != "off" && deskew.status != "no_time_field")
+  {
+    deskew_skipped_window_.add(core::steadySeconds());
+    if (deskew_warned_.insert(deskew.status).second)
+      ROS_WARN("scan_grid: a cloud on %s is not deskewed (%s): %s. Further clouds skipped for this reason are only "
+               "counted (see diagnostics).",
+               cloud_sub_.getTopic().c_str(), deskew.status.c_str(), deskew.detail.c_str());
+  }
   if (!builder_.build(view, grid_, &last_stats_))
   {
     reject("layout", "the point view is inconsistent");
     return;
   }
   counters_.points_rejected += last_stats_.rejected();
+  if (last_stats_.ground_fit.flat_fallback)
+  {
+    ++ground_flat_fallbacks_;
+    ground_fallback_window_.add(core::steadySeconds());
+    ROS_WARN_THROTTLE(1.0, "scan_grid: the ground model fitted no zone of a cloud on %s; that scan used the flat "
+                           "ground (%zu zones with too few points, %zu too steep)",
+                      cloud_sub_.getTopic().c_str(), last_stats_.ground_fit.few_points,
+                      last_stats_.ground_fit.too_steep);
+  }
 
   std_msgs::Header header;
   header.stamp = cloud->header.stamp;
@@ -302,6 +335,8 @@ void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level
   m.mu_occupied = config.mu_occupied;
   m.free_decay_length = config.free_decay_length;
   m.free_margin = config.free_margin;
+  m.deskew = config.deskew;
+  m.ground_model = config.ground_model;
   try
   {
     builder_.configure(m, builder_.sensorPose());
@@ -343,6 +378,23 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   for (const auto& r : counters_.rejections) status.add("clouds rejected: " + r.first, r.second);
   status.add("points rejected", counters_.points_rejected);
   status.add("tf buffer clears (time jump)", tf_clears_);
+  status.add("deskew", !params_.model.deskew ? std::string("off (parameter deskew)") :
+                       last_deskew_ == "no_time_field" ?
+                                               std::string("off: the clouds carry no time field (") +
+                                                   params_.deskew_time_field + ")" :
+                                               "on, last cloud: " + last_deskew_);
+  status.add("deskew skipped in window", deskew_skipped_window_.count(now));
+  for (const auto& d : deskew_counts_) status.add("deskew: " + d.first, d.second);
+  status.add("ground model", params_.model.ground_model);
+  if (params_.model.groundModel() == core::GroundModel::kPlanes)
+  {
+    const core::GroundFitStats& g = last_stats_.ground_fit;
+    status.add("ground flat fallbacks in window", ground_fallback_window_.count(now));
+    status.add("ground flat fallbacks", ground_flat_fallbacks_);
+    status.add("last cloud: ground zones fitted / few points / too steep",
+               std::to_string(g.fitted) + " / " + std::to_string(g.few_points) + " / " + std::to_string(g.too_steep) +
+                   " of " + std::to_string(g.zones));
+  }
   status.add("reconfigure refused", reconfigure_refused_);
   status.add("last reconfigure", last_reconfigure_);
   status.add("last cloud: points", last_stats_.points);

@@ -18,7 +18,7 @@ namespace map_aided_fusion {
 
 namespace {
 
-constexpr std::uint32_t kPointStep = 18;  // 4 float32 + 1 uint16
+constexpr std::uint32_t kPointStep = 22;  // x y z intensity (float32), ring (uint16), time (float32, s after the stamp)
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 geometry_msgs::Quaternion yawQuaternion(double yaw)
@@ -48,7 +48,8 @@ void SimConversions::toPointCloud2(const sim::ScanFrame& frame, const ros::Time&
   msg.fields = { pointField("x", 0, sensor_msgs::PointField::FLOAT32), pointField("y", 4, sensor_msgs::PointField::FLOAT32),
                  pointField("z", 8, sensor_msgs::PointField::FLOAT32),
                  pointField("intensity", 12, sensor_msgs::PointField::FLOAT32),
-                 pointField("ring", 16, sensor_msgs::PointField::UINT16) };
+                 pointField("ring", 16, sensor_msgs::PointField::UINT16),
+                 pointField("time", 18, sensor_msgs::PointField::FLOAT32) };
   msg.is_bigendian = false;
   msg.point_step = kPointStep;
   msg.row_step = kPointStep * msg.width;
@@ -62,6 +63,7 @@ void SimConversions::toPointCloud2(const sim::ScanFrame& frame, const ros::Time&
     std::memcpy(out + 8, &p.z, 4);
     std::memcpy(out + 12, &p.intensity, 4);
     std::memcpy(out + 16, &p.ring, 2);
+    std::memcpy(out + 18, &p.time, 4);
     out += kPointStep;
   }
 }

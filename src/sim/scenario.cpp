@@ -24,6 +24,13 @@ constexpr double kMaxBuildingHeight = 1000.0;
 /// Largest pose or map error a scenario may ask for, metres.
 constexpr double kMaxLocalisationError = 50.0;
 constexpr double kMaxStopSpeed = 5.0;
+constexpr double kMaxGrade = 0.3;
+constexpr double kMinGradeLength = 10.0;
+constexpr double kMaxGradeLength = 10000.0;
+constexpr double kMaxCamber = 0.2;
+constexpr double kMaxCamberWidth = 100.0;
+constexpr double kMaxPitchDeg = 10.0;
+constexpr double kMinPitchPeriod = 0.1;
 
 using core::ParameterError;
 
@@ -207,6 +214,12 @@ void Scenario::validate() const
   core::requireInRange("localisation_error.covariance_rate_hz", le.covariance_rate_hz, 0.1, kMaxTfRate);
   core::requireInRange("map_errors.shift", std::hypot(map_errors.shift.x, map_errors.shift.y), 0.0, kMaxLocalisationError);
   core::requireInRange("map_errors.rotation_deg", map_errors.rotation_deg, -180.0, 180.0);
+  core::requireInRange("terrain.grade", terrain.grade, 0.0, kMaxGrade);
+  core::requireInRange("terrain.grade_length", terrain.grade_length, kMinGradeLength, kMaxGradeLength);
+  core::requireInRange("terrain.camber", terrain.camber, 0.0, kMaxCamber);
+  core::requireInRange("terrain.camber_width", terrain.camber_width, 0.0, kMaxCamberWidth);
+  core::requireInRange("terrain.pitch_amplitude_deg", terrain.pitch_amplitude_deg, 0.0, kMaxPitchDeg);
+  core::requireInRange("terrain.pitch_period", terrain.pitch_period, kMinPitchPeriod, kMaxDuration);
   for (const BuildingOffset& o : map_errors.offsets)
     core::requireInRange("map_errors.offset_buildings.offset", std::hypot(o.offset.x, o.offset.y), 0.0, kMaxLocalisationError);
   for (const WorldBuilding& b : map_errors.unmapped)
@@ -284,6 +297,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
     p.mount_y = get<double>(l, "mount_y", "lidar.", p.mount_y);
     p.mount_z = get<double>(l, "mount_z", "lidar.", p.mount_z);
     p.mount_yaw_deg = get<double>(l, "mount_yaw_deg", "lidar.", p.mount_yaw_deg);
+    p.rolling_sweep = get<bool>(l, "rolling_sweep", "lidar.", p.rolling_sweep);
   }
   if (const YAML::Node g = root["ground_truth"])
   {
@@ -352,6 +366,18 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
     e.white_noise = get<double>(l, "white_noise", p, e.white_noise);
     e.reported_sigma = get<double>(l, "reported_sigma", p, e.reported_sigma);
     e.covariance_rate_hz = get<double>(l, "covariance_rate_hz", p, e.covariance_rate_hz);
+  }
+
+  if (const YAML::Node t = root["terrain"])
+  {
+    Terrain& e = sc.terrain;
+    const std::string p = "terrain.";
+    e.grade = get<double>(t, "grade", p, e.grade);
+    e.grade_length = get<double>(t, "grade_length", p, e.grade_length);
+    e.camber = get<double>(t, "camber", p, e.camber);
+    e.camber_width = get<double>(t, "camber_width", p, e.camber_width);
+    e.pitch_amplitude_deg = get<double>(t, "pitch_amplitude_deg", p, e.pitch_amplitude_deg);
+    e.pitch_period = get<double>(t, "pitch_period", p, e.pitch_period);
   }
 
   if (const YAML::Node objects = root["objects"])

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "map_aided_fusion/core/parameters.hpp"
 
@@ -13,6 +14,8 @@ namespace {
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
 constexpr double kTimeEpsilon = 1e-9;
+/// Half the base over which the body's pitch and roll follow the terrain (wheelbase, track), m.
+constexpr double kBodyHalfBase = 1.4;
 
 /// splitmix64: small, fast, and the same on every platform (unlike std::normal_distribution).
 class Rng
@@ -216,6 +219,42 @@ Pose2 Simulator::lidarPose(const Pose2& ego) const
                 ego.yaw + l.mount_yaw_deg * kDegToRad };
 }
 
+double Simulator::terrainHeight(double x, double y) const
+{
+  const Terrain& tr = scenario_.terrain;
+  double h = 0.0;
+  if (tr.grade > 0.0) h += tr.grade * tr.grade_length / kTwoPi * std::sin(kTwoPi * x / tr.grade_length);
+  if (tr.camber > 0.0)
+  {
+    const std::vector<Point2>& route = scenario_.ego.route;
+    double d2 = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i + 1 < route.size(); ++i)
+    {
+      const Point2 a = route[i], b = route[i + 1];
+      const double ex = b.x - a.x, ey = b.y - a.y, len2 = ex * ex + ey * ey;
+      const double u = len2 > 0.0 ? std::clamp(((x - a.x) * ex + (y - a.y) * ey) / len2, 0.0, 1.0) : 0.0;
+      const double px = a.x + u * ex - x, py = a.y + u * ey - y;
+      d2 = std::min(d2, px * px + py * py);
+    }
+    if (route.size() == 1) d2 = (x - route[0].x) * (x - route[0].x) + (y - route[0].y) * (y - route[0].y);
+    h -= tr.camber * std::min(std::sqrt(d2), tr.camber_width);
+  }
+  return h;
+}
+
+void Simulator::bodyAttitude(double t, double& pitch, double& roll) const
+{
+  const Terrain& tr = scenario_.terrain;
+  pitch = roll = 0.0;
+  if (!tr.any()) return;
+  const Pose2 e = egoPose(t);
+  const double c = std::cos(e.yaw), s = std::sin(e.yaw), a = kBodyHalfBase;
+  const double along = (terrainHeight(e.x + a * c, e.y + a * s) - terrainHeight(e.x - a * c, e.y - a * s)) / (2 * a);
+  const double side = (terrainHeight(e.x - a * s, e.y + a * c) - terrainHeight(e.x + a * s, e.y - a * c)) / (2 * a);
+  pitch = -std::atan(along) + tr.pitch_amplitude_deg * kDegToRad * std::sin(kTwoPi * t / tr.pitch_period);
+  roll = std::atan(side);
+}
+
 void Simulator::objectsAt(double t, std::vector<WorldObject>& solids, std::vector<ObjectTruth>& truth) const
 {
   solids.clear();
@@ -283,12 +322,35 @@ void Simulator::scan(int k, ScanFrame& out)
   const int beams = lidar.numBeams();
   const int azimuths = lidar.numAzimuths();
   const double oz = lidar.mount_z;
+  const bool terrain = scenario_.terrain.any();
+  std::vector<double>& tilted = tilted_slopes_;
+  tilted.assign(slopes_.begin(), slopes_.end());
+  Pose2 origin = out.lidar;
+  double pitch = 0.0, roll = 0.0, origin_h = 0.0;
+  if (terrain) bodyAttitude(out.time, pitch, roll);
   for (int i = 0; i < azimuths; ++i)
   {
+    const double offset = lidar.rolling_sweep ? scanPeriod() * i / azimuths : 0.0;
+    if (lidar.rolling_sweep)
+    {
+      origin = lidarPose(egoPose(out.time + offset));
+      if (terrain) bodyAttitude(out.time + offset, pitch, roll);
+    }
+    if (terrain) origin_h = terrainHeight(origin.x, origin.y);
     const double az_l = lidar.azimuthDeg(i) * kDegToRad;
-    const double az_w = out.lidar.yaw + az_l;
-    scene_->castFan(out.lidar.x, out.lidar.y, oz, az_w, slopes_.data(), max_s_.data(), beams, hits_.data());
+    const double az_w = origin.yaw + az_l;
     const double ca = std::cos(az_l), sa = std::sin(az_l);
+    const double cp = std::cos(pitch), sp = std::sin(pitch), cr = std::cos(roll), sr = std::sin(roll);
+    if (terrain)
+      for (int b = 0; b < beams; ++b)
+      {
+        // World elevation of the beam: the body-frame direction turned by roll (x) then pitch (y).
+        const double dx = cos_e_[b] * ca, dy = cos_e_[b] * sa, dz = sin_e_[b];
+        const double y1 = cr * dy - sr * dz, z1 = sr * dy + cr * dz;
+        const double x2 = cp * dx + sp * z1, z2 = -sp * dx + cp * z1;
+        tilted[b] = z2 / std::hypot(x2, y1);
+      }
+    scene_->castFan(origin.x, origin.y, oz, az_w, tilted.data(), max_s_.data(), beams, hits_.data());
     double s_obs = -1.0;
     for (int b = 0; b < beams; ++b)
     {
@@ -306,24 +368,41 @@ void Simulator::scan(int k, ScanFrame& out)
         ++out.dropped;
         continue;
       }
-      const double r = h.s / cos_e_[b] + lidar.range_noise_stddev * rng.gaussian();
+      const double cos_w = terrain ? 1.0 / std::sqrt(1.0 + tilted[b] * tilted[b]) : cos_e_[b];
+      const double r = h.s / cos_w + lidar.range_noise_stddev * rng.gaussian();
       if (r < lidar.min_range || r > lidar.max_range)
       {
         ++out.dropped;
         continue;
       }
-      const double horizontal = r * cos_e_[b];
       LidarPoint p;
-      p.x = static_cast<float>(horizontal * ca);
-      p.y = static_cast<float>(horizontal * sa);
-      p.z = static_cast<float>(r * sin_e_[b]);
+      if (terrain)
+      {
+        // The return in the level frame of the lidar's yaw, raised by the terrain, then into the tilted body.
+        const double horizontal = r * cos_w;
+        const double hx = horizontal * std::cos(az_w), hy = horizontal * std::sin(az_w);
+        const double lift = terrainHeight(origin.x + hx, origin.y + hy) - origin_h;
+        const double vx = horizontal * ca, vy = horizontal * sa, vz = r * tilted[b] * cos_w + lift;
+        const double x1 = cp * vx - sp * vz, z1 = sp * vx + cp * vz;
+        p.x = static_cast<float>(x1);
+        p.y = static_cast<float>(cr * vy + sr * z1);
+        p.z = static_cast<float>(-sr * vy + cr * z1);
+      }
+      else
+      {
+        const double horizontal = r * cos_e_[b];
+        p.x = static_cast<float>(horizontal * ca);
+        p.y = static_cast<float>(horizontal * sa);
+        p.z = static_cast<float>(r * sin_e_[b]);
+      }
       p.intensity = materialIntensity(scene_->materialOf(h.solid));
       p.ring = static_cast<std::uint16_t>(b);
+      p.time = static_cast<float>(offset);
       out.points.push_back(p);
     }
     if (s_obs >= 0.0)
-      traverseCells(out.truth_geometry, core::Point2{ out.lidar.x, out.lidar.y }, std::cos(az_w), std::sin(az_w),
-                    s_obs, [&](std::size_t c) { observed_[c] = 1; });
+      traverseCells(out.truth_geometry, core::Point2{ origin.x, origin.y }, std::cos(az_w), std::sin(az_w), s_obs,
+                    [&](std::size_t c) { observed_[c] = 1; });
   }
   for (std::size_t c = 0; c < observed_.size(); ++c)
     if (!observed_[c]) out.truth_classes[c] = static_cast<std::int8_t>(core::CellClass::kUnknown);

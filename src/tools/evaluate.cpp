@@ -41,6 +41,7 @@
 #include "map_aided_fusion/map_io/yaml_params.hpp"
 #include "map_aided_fusion/ros/eval_conversions.hpp"
 #include "map_aided_fusion/ros/kitti_bag.hpp"
+#include "map_aided_fusion/ros/cloud_deskew.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
 
 namespace fs = std::filesystem;
@@ -107,6 +108,14 @@ core::ScanGridParams scanGridParams(const YAML::Node& n)
   core::forEachParam(p, map_io::yamlReader(n));
   p.validate();
   return p;
+}
+
+/// "applied 600" or "no_time_field 10", "applied 580, time_out_of_sweep 20"...
+std::string deskewSummary(const std::map<std::string, std::size_t>& status)
+{
+  std::string out;
+  for (const auto& s : status) out += (out.empty() ? "" : ", ") + s.first + " " + std::to_string(s.second);
+  return out.empty() ? "none" : out;
 }
 
 // ---- NumPy .npy writer -----------------------------------------------------------------------------------
@@ -491,6 +500,8 @@ int main(int argc, char** argv)
     // Pass 2: scans (and, for labelled real data, the sweep's labelled points).
     std::optional<double> t0;
     std::size_t done = 0, no_truth = 0, no_pose = 0;
+    CloudDeskewer deskewer;
+    std::map<std::string, std::size_t> deskew_status;
     double snapshot_at = -1.0, next_sheet = 0.0;
     int sheet_frame = 0;
     const double duration_guess = [&] {
@@ -551,6 +562,11 @@ int main(int argc, char** argv)
       std::string detail;
       if (makePointCloudView(*cloud, pv, &detail) != CloudRejection::kNone)
         throw std::runtime_error("unreadable cloud in " + opt.bag + ": " + detail);
+      core::PointCloudView deskewed;
+      const DeskewResult deskew =
+          deskewer.apply(*cloud, pv, true, "auto", configured.scan_grid.deskew_max_sweep_duration, tf, opt.map_frame,
+                         deskewed);
+      ++deskew_status[deskew.status];
       const double t = cloud->header.stamp.toSec();
       if (!t0) t0 = t;
       const core::Pose2 pose{ base.transform.translation.x, base.transform.translation.y,
@@ -571,7 +587,7 @@ int main(int argc, char** argv)
         }
         else
           v->builder.setSensorPose(KittiConversions::toIsometry(sensor));
-        v->builder.build(pv, v->scan);
+        v->builder.build(v->scan_params.deskew ? deskewed : pv, v->scan);
         const core::ObstaclePoints obstacles = v->builder.obstaclePoints();
         double sigma = v->grid.params().position_sigma;
         if (auto c = covariance_sigma.upper_bound(k); c != covariance_sigma.begin()) sigma = std::prev(c)->second;
@@ -746,6 +762,7 @@ int main(int argc, char** argv)
                                                                        std::to_string(covariance_rejected) + " rejected" },
                                              { "scans", std::to_string(done) },
                                              { "scans_without_pose", std::to_string(no_pose) },
+                                             { "deskew", deskewSummary(deskew_status) },
                                              { "scans_without_ground_truth", std::to_string(no_truth) },
                                              { "labelled_scans", std::to_string(labelled_stamps.size()) },
                                              { "figure_time_s", std::to_string(snapshot_at) } };

@@ -38,7 +38,8 @@ ScanGridParams testParams()
   p.obstacle_max_height = 2.5;
   p.mu_free = 0.7;
   p.mu_occupied = 0.8;
-  p.relative_height_limit = 0.0;  // the paper's sensor model; the step has its own tests
+  p.relative_height_limit = 0.0;  // the paper's sensor model; the steps have their own tests
+  p.ground_model = "flat";
   return p;
 }
 

@@ -102,67 +102,74 @@ TEST(ScanGridReal, NuscenesBoxesAreOccupiedAndTheSurroundingsFree)
   }
   ASSERT_EQ(boxes.size(), 69u);
 
-  ScanGridParams params = realParams();
-  setNuscenesSelfBox(params);
-  ScanGridBuilder builder(params, lidar_to_ego);
-  ScanMassGrid grid;
-  ScanGridStats st;
-  ASSERT_TRUE(builder.build(
-      PointCloudView::packed(raw.data(), n, kNuscenesFloatsPerPoint * sizeof(float)), grid, &st));
-  std::cout << "[ INFO     ] nuScenes sweep: " << st.points << " points, ground " << st.ground << ", obstacle "
-            << st.obstacle << ", self " << st.self_returns << ", below ground " << st.below_ground << ", gap " << st.height_gap
-            << ", above clearance " << st.above_clearance << ", rejected " << st.rejected() << " (min range "
-            << st.below_min_range << ", max range " << st.beyond_max_range << "); cells occupied "
-            << st.occupied_cells << ", free " << st.free_cells << std::endl;
-
-  const GridGeometry& g = grid.geometry();
-  const Eigen::Isometry3d ego_to_lidar = lidar_to_ego.inverse();
-  const float* m_o = grid.plane(FrameSG::kO);
-  const float* m_f = grid.plane(FrameSG::kF);
-  const float occupied_threshold = static_cast<float>(params.mu_occupied) - 1e-6f;
-  std::vector<char> covered(g.numCells(), 0);
-  std::size_t checked = 0, hit = 0;
-  for (const Box& box : boxes)
+  for (const char* model : { "flat", "planes" })
   {
-    bool box_hit = false;
+    SCOPED_TRACE(model);
+    std::cout << "[ INFO     ] ground_model " << model << "\n";
+    ScanGridParams params = realParams();
+    setNuscenesSelfBox(params);
+    params.ground_model = model;
+    ScanGridBuilder builder(params, lidar_to_ego);
+    ScanMassGrid grid;
+    ScanGridStats st;
+    ASSERT_TRUE(builder.build(
+        PointCloudView::packed(raw.data(), n, kNuscenesFloatsPerPoint * sizeof(float)), grid, &st));
+    std::cout << "[ INFO     ] nuScenes sweep: " << st.points << " points, ground " << st.ground << ", obstacle "
+              << st.obstacle << ", self " << st.self_returns << ", below ground " << st.below_ground << ", gap " << st.height_gap
+              << ", above clearance " << st.above_clearance << ", rejected " << st.rejected() << " (min range "
+              << st.below_min_range << ", max range " << st.beyond_max_range << "); cells occupied "
+              << st.occupied_cells << ", free " << st.free_cells << std::endl;
+
+    const GridGeometry& g = grid.geometry();
+    const Eigen::Isometry3d ego_to_lidar = lidar_to_ego.inverse();
+    const float* m_o = grid.plane(FrameSG::kO);
+    const float* m_f = grid.plane(FrameSG::kF);
+    const float occupied_threshold = static_cast<float>(params.mu_occupied) - 1e-6f;
+    std::vector<char> covered(g.numCells(), 0);
+    std::size_t checked = 0, hit = 0;
+    for (const Box& box : boxes)
+    {
+      bool box_hit = false;
+      for (int y = 0; y < g.height; ++y)
+        for (int x = 0; x < g.width; ++x)
+        {
+          const Point2 c = g.cellCentre({ x, y });
+          const Eigen::Vector3d l = ego_to_lidar * Eigen::Vector3d(c.x, c.y, 0.0);
+          if (!box.contains(l.x(), l.y())) continue;
+          covered[g.index(x, y)] = 1;
+          if (m_o[g.index(x, y)] >= occupied_threshold) box_hit = true;
+        }
+      if (box.points < kMinBoxPoints) continue;
+      ++checked;
+      hit += box_hit;
+      if (!box_hit)
+        std::cout << "[ INFO     ] box without an occupied cell: " << box.label << " with " << box.points
+                  << " points at (" << box.x << ", " << box.y << ") in the lidar frame" << std::endl;
+    }
+    ASSERT_GT(checked, 0u);
+    const double hit_rate = static_cast<double>(hit) / static_cast<double>(checked);
+    std::cout << "[ INFO     ] boxes with >= " << kMinBoxPoints << " points: " << checked << ", with an occupied cell "
+              << hit << " (" << 100.0 * hit_rate << " %)" << std::endl;
+    EXPECT_GE(hit_rate, 0.9);
+
+    std::size_t near = 0, near_free = 0, near_occupied = 0;
     for (int y = 0; y < g.height; ++y)
       for (int x = 0; x < g.width; ++x)
       {
         const Point2 c = g.cellCentre({ x, y });
-        const Eigen::Vector3d l = ego_to_lidar * Eigen::Vector3d(c.x, c.y, 0.0);
-        if (!box.contains(l.x(), l.y())) continue;
-        covered[g.index(x, y)] = 1;
-        if (m_o[g.index(x, y)] >= occupied_threshold) box_hit = true;
+        const std::size_t i = g.index(x, y);
+        if (std::hypot(c.x, c.y) > kNearRadius || covered[i]) continue;
+        ++near;
+        near_free += m_f[i] > 0.0f;
+        near_occupied += m_o[i] > 0.0f;
       }
-    if (box.points < kMinBoxPoints) continue;
-    ++checked;
-    hit += box_hit;
-    if (!box_hit)
-      std::cout << "[ INFO     ] box without an occupied cell: " << box.label << " with " << box.points
-                << " points at (" << box.x << ", " << box.y << ") in the lidar frame" << std::endl;
-  }
-  ASSERT_GT(checked, 0u);
-  const double hit_rate = static_cast<double>(hit) / static_cast<double>(checked);
-  std::cout << "[ INFO     ] boxes with >= " << kMinBoxPoints << " points: " << checked << ", with an occupied cell "
-            << hit << " (" << 100.0 * hit_rate << " %)" << std::endl;
-  EXPECT_GE(hit_rate, 0.9);
+    const double free_rate = static_cast<double>(near_free) / static_cast<double>(near);
+    std::cout << "[ INFO     ] cells within " << kNearRadius << " m not covered by a box: " << near << ", free "
+              << near_free << " (" << 100.0 * free_rate << " %), occupied " << near_occupied << std::endl;
+    EXPECT_GE(free_rate, 0.9);
+    EXPECT_GT(st.self_returns, 0u);
 
-  std::size_t near = 0, near_free = 0, near_occupied = 0;
-  for (int y = 0; y < g.height; ++y)
-    for (int x = 0; x < g.width; ++x)
-    {
-      const Point2 c = g.cellCentre({ x, y });
-      const std::size_t i = g.index(x, y);
-      if (std::hypot(c.x, c.y) > kNearRadius || covered[i]) continue;
-      ++near;
-      near_free += m_f[i] > 0.0f;
-      near_occupied += m_o[i] > 0.0f;
-    }
-  const double free_rate = static_cast<double>(near_free) / static_cast<double>(near);
-  std::cout << "[ INFO     ] cells within " << kNearRadius << " m not covered by a box: " << near << ", free "
-            << near_free << " (" << 100.0 * free_rate << " %), occupied " << near_occupied << std::endl;
-  EXPECT_GE(free_rate, 0.9);
-  EXPECT_GT(st.self_returns, 0u);
+  }
 }
 
 TEST(ScanGridReal, OrganizedScanNoReturnPointsNeverOccupyTheSensorCell)
@@ -202,26 +209,32 @@ TEST(ScanGridReal, OrganizedScanNoReturnPointsNeverOccupyTheSensorCell)
 
   // No pose: the sensor frame is base_link, the ground ~1.8 m below. With no min range, a (0, 0, 0)
   // point taken as a return would be an obstacle (z = 0 is in the band [−1.5, 0.7]) in the sensor's cell.
-  ScanGridParams params = realParams();
-  params.min_range = 0.0;
-  params.ground_height = -1.8;
-  ScanGridBuilder builder(params, Eigen::Isometry3d::Identity());
-  ScanMassGrid grid;
-  ScanGridStats st;
-  ASSERT_TRUE(builder.build(organized, grid, &st));
-  std::cout << "[ INFO     ] organized scan: " << st.points << " points, (0,0,0) " << st.no_return
-            << ", non-finite " << st.non_finite << ", ground " << st.ground << ", obstacle " << st.obstacle
-            << "; cells occupied " << st.occupied_cells << ", free " << st.free_cells << std::endl;
-  EXPECT_GT(zeros, 0u);
-  EXPECT_EQ(st.no_return, zeros);
-  EXPECT_GT(st.occupied_cells, 0u);
-  const GridGeometry& g = grid.geometry();
-  std::size_t near_occupied = 0;
-  for (int y = 0; y < g.height; ++y)
-    for (int x = 0; x < g.width; ++x)
-    {
-      const Point2 c = g.cellCentre({ x, y });
-      if (std::hypot(c.x, c.y) <= 1.0 && grid.plane(FrameSG::kO)[g.index(x, y)] > 0.0f) ++near_occupied;
-    }
-  EXPECT_EQ(near_occupied, 0u);
+  for (const char* model : { "flat", "planes" })
+  {
+    SCOPED_TRACE(model);
+    std::cout << "[ INFO     ] ground_model " << model << "\n";
+    ScanGridParams params = realParams();
+    params.min_range = 0.0;
+    params.ground_height = -1.8;
+    params.ground_model = model;
+    ScanGridBuilder builder(params, Eigen::Isometry3d::Identity());
+    ScanMassGrid grid;
+    ScanGridStats st;
+    ASSERT_TRUE(builder.build(organized, grid, &st));
+    std::cout << "[ INFO     ] organized scan: " << st.points << " points, (0,0,0) " << st.no_return
+              << ", non-finite " << st.non_finite << ", ground " << st.ground << ", obstacle " << st.obstacle
+              << "; cells occupied " << st.occupied_cells << ", free " << st.free_cells << std::endl;
+    EXPECT_GT(zeros, 0u);
+    EXPECT_EQ(st.no_return, zeros);
+    EXPECT_GT(st.occupied_cells, 0u);
+    const GridGeometry& g = grid.geometry();
+    std::size_t near_occupied = 0;
+    for (int y = 0; y < g.height; ++y)
+      for (int x = 0; x < g.width; ++x)
+      {
+        const Point2 c = g.cellCentre({ x, y });
+        if (std::hypot(c.x, c.y) <= 1.0 && grid.plane(FrameSG::kO)[g.index(x, y)] > 0.0f) ++near_occupied;
+      }
+    EXPECT_EQ(near_occupied, 0u);
+  }
 }

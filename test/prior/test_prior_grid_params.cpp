@@ -3,6 +3,8 @@
 
 #include <map>
 #include <set>
+#include <string>
+#include <type_traits>
 
 #include <yaml-cpp/yaml.h>
 
@@ -139,12 +141,18 @@ TEST(PublishedWindow, CappedToASquareAroundTheCentre)
 
 namespace {
 
-/// name → value of every parameter of @p p (bools as 0/1), through the shared parameter list.
+/// name → value of every parameter of @p p (numbers and bools printed, strings as they are), through the shared
+/// parameter list.
 template <class Params>
-std::map<std::string, double> valuesOf(Params p)
+std::map<std::string, std::string> valuesOf(Params p)
 {
-  std::map<std::string, double> out;
-  core::forEachParam(p, [&](const std::string& name, auto& v) { out[name] = static_cast<double>(v); });
+  std::map<std::string, std::string> out;
+  core::forEachParam(p, [&](const std::string& name, auto& v) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>)
+      out[name] = v;
+    else
+      out[name] = std::to_string(static_cast<double>(v));
+  });
   return out;
 }
 
@@ -191,4 +199,19 @@ TEST(Profiles, ConfigFilesHoldTheDefaultAndThePaperProfiles)
     if (options.count(kv.first.as<std::string>())) continue;
     EXPECT_EQ(YAML::Dump(kv.second), YAML::Dump(b[kv.first.as<std::string>()])) << kv.first;
   }
+}
+
+TEST(Profiles, IbeoScanGridDiffersFromTheDefaultOnlyWhereTheSensorNeedsIt)
+{
+  const std::string dir = std::string(MAF_PACKAGE_DIR) + "/config/";
+  const core::ScanGridParams ibeo = loadFile<core::ScanGridParams>(dir + "ibeo/scan_grid.yaml");
+  EXPECT_NO_THROW(ibeo.validate());
+  const auto a = valuesOf(ibeo), b = valuesOf(core::defaultProfile().scan_grid);
+  std::set<std::string> differ;
+  for (const auto& kv : a)
+    if (b.at(kv.first) != kv.second) differ.insert(kv.first);
+  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "ground_model", "relative_height_limit" }));
+  EXPECT_EQ(ibeo.groundModel(), core::GroundModel::kFlat);
+  EXPECT_EQ(ibeo.grid_resolution, 0.5) << "the paper's cells";
+  EXPECT_EQ(ibeo.grid_size_x, 100.0) << "the paper's window";
 }

@@ -157,6 +157,78 @@ TEST(SimSimulator, PointsAreExactWithoutNoise)
   EXPECT_NEAR(car->y, -7.1, 1e-5);
 }
 
+TEST(SimSimulator, RollingSweepFiresEachAzimuthAtItsOwnTimeAndPose)
+{
+  Scenario sc = smallScenario();
+  sc.ego.route = { { -8.0, 0.0 }, { 8.0, 0.0 } };
+  sc.ego.motion.speed = 10.0;
+  sc.ego.motion.acceleration = 20.0;
+  sc.objects.clear();
+  sc.lidar.rolling_sweep = true;
+  Simulator sim(sc, smallMap());
+  ScanFrame f;
+  sim.scan(3, f);
+  ASSERT_FALSE(f.points.empty());
+  EXPECT_EQ(f.points.front().time, 0.0f);
+  for (std::size_t i = 1; i < f.points.size(); ++i) ASSERT_GE(f.points[i].time, f.points[i - 1].time);
+  EXPECT_LT(f.points.back().time, static_cast<float>(sim.scanPeriod()));
+  // The level ray along +x (firing 360 of 720, half a period in) meets A's wall at x = 10 from where the ego is then.
+  const auto it = std::find_if(f.points.begin(), f.points.end(),
+                               [](const LidarPoint& p) { return std::abs(p.y) < 1e-6 && p.x > 0.0f; });
+  ASSERT_NE(it, f.points.end());
+  EXPECT_NEAR(it->time, 0.5 * sim.scanPeriod(), 1e-6);
+  const double ego_then = sim.egoPose(f.time + it->time).x;
+  EXPECT_NEAR(it->x, 10.0 - ego_then, 1e-4);
+  EXPECT_GT(ego_then - f.ego.x, 0.4) << "the ego moved half a period at 10 m/s";
+  // Without the rolling sweep every point is taken at the stamp.
+  sc.lidar.rolling_sweep = false;
+  Simulator still(sc, smallMap());
+  still.scan(3, f);
+  for (const LidarPoint& p : f.points) ASSERT_EQ(p.time, 0.0f);
+}
+
+TEST(SimSimulator, TerrainReturnsLieOnTheSurfaceSeenFromThePitchingBody)
+{
+  Scenario sc = smallScenario();
+  sc.lidar.elevations_deg = { -12.0, -8.0 };
+  sc.objects.clear();
+  sc.terrain.grade = 0.05;
+  sc.terrain.grade_length = 100.0;
+  sc.terrain.camber = 0.02;
+  sc.terrain.pitch_amplitude_deg = 1.0;
+  sc.terrain.pitch_period = 2.0;
+  Simulator sim(sc, smallMap());
+  ScanFrame f;
+  sim.scan(5, f);
+  double pitch = 0.0, roll = 0.0;
+  sim.bodyAttitude(f.time, pitch, roll);
+  EXPECT_NE(pitch, 0.0);
+  const double lidar_h = sim.terrainHeight(f.lidar.x, f.lidar.y);
+  std::size_t ground = 0;
+  double worst = 0.0, spread_lo = 1e9, spread_hi = -1e9;
+  for (const LidarPoint& p : f.points)
+  {
+    if (p.intensity != materialIntensity(Material::kGround)) continue;
+    // Body → level frame: roll about x, then pitch about y.
+    const double y1 = std::cos(roll) * p.y - std::sin(roll) * p.z, z1 = std::sin(roll) * p.y + std::cos(roll) * p.z;
+    const double vx = std::cos(pitch) * p.x + std::sin(pitch) * z1, vz = -std::sin(pitch) * p.x + std::cos(pitch) * z1;
+    const double c = std::cos(f.lidar.yaw), s = std::sin(f.lidar.yaw);
+    const double wx = f.lidar.x + c * vx - s * y1, wy = f.lidar.y + s * vx + c * y1;
+    const double wz = lidar_h + sc.lidar.mount_z + vz;
+    worst = std::max(worst, std::abs(wz - sim.terrainHeight(wx, wy)));
+    spread_lo = std::min(spread_lo, static_cast<double>(p.z));
+    spread_hi = std::max(spread_hi, static_cast<double>(p.z));
+    ++ground;
+  }
+  ASSERT_GT(ground, 500u);
+  EXPECT_LT(worst, 1e-4);
+  // Seen from the body the ground is not at one height (on flat ground every ground return has z = -mount_z).
+  EXPECT_GT(spread_hi - spread_lo, 0.1);
+  // The terrain: hills along x and a crown on the route (here a single point).
+  EXPECT_NEAR(sim.terrainHeight(25.0, 0.0), 0.05 * 100.0 / (2.0 * 3.14159265358979323846) - 0.02 * 7.0, 1e-9);
+  EXPECT_NEAR(sim.terrainHeight(0.0, 3.0), -0.06, 1e-9);
+}
+
 TEST(SimSimulator, ObjectsMoveAndStopInScans)
 {
   Scenario sc = smallScenario();
@@ -297,6 +369,9 @@ TEST(SimScenario, ErrorsNameTheKey)
   const std::string ego = "ego: {route: [[0, 0]], speed: 0}\n";
   EXPECT_EQ(keyOf(ego + "lidar: {preset: vlp32, max_range: -1}"), "lidar.max_range");
   EXPECT_EQ(keyOf(ego + "lidar: {preset: velodyne}"), "lidar.preset");
+  EXPECT_EQ(keyOf(ego + "terrain: {grade: 0.5}"), "terrain.grade");
+  EXPECT_EQ(keyOf(ego + "terrain: {pitch_period: 0}"), "terrain.pitch_period");
+  EXPECT_EQ(keyOf(ego + "lidar: {preset: vlp32, rolling_sweep: maybe}"), "lidar.rolling_sweep");
   EXPECT_EQ(keyOf(ego + "objects: [{kind: dragon, at: [0, 0]}]"), "objects[0].kind");
   EXPECT_EQ(keyOf(ego + "objects: [{kind: car, path: [[0, 0], [1]]}]"), "objects[0].path[1]");
   EXPECT_EQ(keyOf(ego + "duration: abc"), "duration");

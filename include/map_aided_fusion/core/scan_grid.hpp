@@ -23,17 +23,22 @@
  * The Cartesian grid samples the polar model at each cell centre; the cell → (sector, range, μ_F(r))
  * table is computed once per (parameters, geometry, sensor position), not per scan. It lists the cells of
  * each sector by increasing range, so a scan only writes its free cells after resetting the planes.
- * ROS-free: Eigen and the standard library only.
+ * The heights above are measured from the ground: z = ground_height with the paper's flat model, the plane of the
+ * return's zone with the `planes` ground model (core/ground_model.hpp, the one place PCL is used).
+ * ROS-free: Eigen and the standard library in this header.
  */
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "map_aided_fusion/core/grid_geometry.hpp"
+#include "map_aided_fusion/core/ground_model.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
 
 namespace map_aided_fusion {
@@ -90,6 +95,30 @@ struct ScanGridParams
    */
   double relative_height_limit = 0.8;
 
+  /**
+   * Step "deskew" (not in the paper): clouds whose points carry a time field are moved to the sensor's pose at
+   * the cloud's stamp before the grid is built (core/deskew.hpp; done by the caller, which knows the motion).
+   */
+  bool deskew = true;
+  double deskew_max_sweep_duration = 0.2;  ///< s, a point time beyond this after the stamp skips deskewing, (0, 10]
+
+  /// Step "ground model" (not in the paper): `flat` (z = ground_height) or `planes` (core/ground_model.hpp).
+  std::string ground_model = "planes";
+  int ground_sectors = 8;               ///< azimuth sectors per ring of the `planes` model, in [1, 64]
+  double ground_max_slope_deg = 15.0;   ///< a fitted plane steeper than this is a wall, not ground, deg, [0, 60]
+  int ground_min_points = 20;           ///< candidates and inliers a zone's fit needs, in [3, 100000]
+  double ground_search_band = 0.6;      ///< m, a zone's candidates lie within this of the predicted ground, (0, 10]
+  double ground_fit_tolerance = 0.08;   ///< m, RANSAC inlier distance, (0, ground_search_band]
+
+  /// ground_model parsed.
+  GroundModel groundModel() const { return parseGroundModel(ground_model); }
+  /// The `planes` model's parameters.
+  GroundModelParams groundModelParams() const
+  {
+    return GroundModelParams{ ground_sectors,     ground_max_slope_deg, ground_min_points,
+                              ground_search_band, ground_fit_tolerance, ground_height };
+  }
+
   /// The grid described by the grid_* parameters.
   GridGeometry geometry() const
   {
@@ -128,6 +157,14 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("free_decay_length", p.free_decay_length);
   get("free_margin", p.free_margin);
   get("relative_height_limit", p.relative_height_limit);
+  get("deskew", p.deskew);
+  get("deskew_max_sweep_duration", p.deskew_max_sweep_duration);
+  get("ground_model", p.ground_model);
+  get("ground_sectors", p.ground_sectors);
+  get("ground_max_slope_deg", p.ground_max_slope_deg);
+  get("ground_min_points", p.ground_min_points);
+  get("ground_search_band", p.ground_search_band);
+  get("ground_fit_tolerance", p.ground_fit_tolerance);
 }
 
 /// Largest grid the builder accepts (cells), to refuse absurd sizes before allocating.
@@ -160,6 +197,7 @@ struct PointCloudView
 };
 
 /// Counts of one build. rejected() = invalid returns; the others are valid returns by class.
+/// (ground_fit is the `planes` model's, when on.)
 struct ScanGridStats
 {
   std::size_t points = 0;               ///< points in the view
@@ -177,6 +215,7 @@ struct ScanGridStats
   std::size_t low_relief = 0;           ///< in the obstacle band but too close to the local lowest return (neither)
   std::size_t occupied_cells = 0;       ///< cells with m(O) = μ_O
   std::size_t free_cells = 0;           ///< cells with m(F) > 0
+  GroundFitStats ground_fit;            ///< the `planes` ground model's fit (all 0 with `flat`)
 
   std::size_t rejected() const { return non_finite + no_return + below_min_range + beyond_max_range + self_returns; }
 };
@@ -227,6 +266,8 @@ public:
   int sectorOf(double dx, double dy) const;
   /// How many times the table was computed (for tests: it must not be per scan).
   std::size_t tableBuilds() const { return table_builds_; }
+  /// The ground planes of the last build() with the `planes` model (zones of the sensor-centred model).
+  const GroundPlaneFitter& groundModel() const { return ground_; }
 
 private:
   void buildTable();
@@ -266,6 +307,12 @@ private:
   std::size_t obstacle_count_ = 0;
   std::vector<float> obstacle_z_;
   std::vector<float> cell_min_z_;
+  // The `planes` ground model: the valid returns (relative to the sensor) and their zones, then the fitter.
+  GroundModel ground_kind_ = GroundModel::kFlat;
+  std::vector<float> valid_dx_, valid_dy_, valid_z_;
+  std::vector<std::uint16_t> valid_zone_;
+  std::vector<std::uint32_t> valid_sector_;
+  GroundPlaneFitter ground_;
 };
 
 }  // namespace core

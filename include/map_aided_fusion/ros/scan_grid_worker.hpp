@@ -31,6 +31,7 @@
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/core/sliding_window.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
+#include "map_aided_fusion/ros/cloud_deskew.hpp"
 
 namespace map_aided_fusion {
 
@@ -44,6 +45,8 @@ struct ScanGridNodeParams
   double time_jump_threshold = 1.0;      ///< s ROS time must go back by to count as a jump (tf buffer cleared)
   core::StreamHealthParams health;       ///< diagnostic period, window and staleness
   core::ScanGridParams model;            ///< sensor model and grid, see core::ScanGridParams
+  std::string deskew_fixed_frame = "map";  ///< frame the vehicle moves in, for the sweep's motion (odom on a vehicle)
+  std::string deskew_time_field = "auto";  ///< per-point time field, or auto (see knownTimeFields())
 
   /// @throws core::ParameterError naming the first bad parameter.
   void validate() const;
@@ -98,9 +101,15 @@ private:
   core::ScanMassGrid grid_;
   ScanGridNodeCounters counters_;
   std::set<std::string> reported_;  // rejection reasons already logged as errors
+  CloudDeskewer deskewer_;
+  std::map<std::string, std::size_t> deskew_counts_;  // clouds by deskew status, since start
+  std::set<std::string> deskew_warned_;               // skip reasons already warned about
+  std::string last_deskew_ = "none";
+  std::size_t ground_flat_fallbacks_ = 0;             // scans whose ground model fell back to flat
 
   // Diagnostics over the last health.diagnostic_window seconds (wall time).
-  core::SlidingCounter received_window_, published_window_, rejected_window_;
+  core::SlidingCounter received_window_, published_window_, rejected_window_, deskew_skipped_window_,
+      ground_fallback_window_;
   double window_processing_sum_ = 0.0;
   double window_processing_max_ = 0.0;
   std::size_t window_processed_ = 0;

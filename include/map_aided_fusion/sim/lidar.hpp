@@ -3,8 +3,9 @@
  * @brief Lidar models: beam elevations, azimuth sampling, range limits and noise, with presets for the
  *        paper's 4-layer IBEO Alaska XT and for 32/64-beam spinning lidars.
  *
- * The lidar frame is level (no roll or pitch) and mounted on base_link at (x, y, z, yaw). All rays of a
- * scan are cast from the pose of the scan's time stamp (no motion distortion within a sweep).
+ * The lidar frame is mounted on base_link at (x, y, z, yaw), level with the vehicle's body. By default all rays
+ * of a scan are cast from the pose of the scan's time stamp; with `rolling_sweep` each azimuth fires at its own
+ * time over the scan period, from the ego's pose at that time (a real spinning lidar's motion distortion).
  */
 #pragma once
 
@@ -31,6 +32,12 @@ struct LidarParams
   double mount_y = 0.0;
   double mount_z = 1.9;
   double mount_yaw_deg = 0.0;
+  /**
+   * Firing i of n (azimuth order) at i / n of the scan period after the scan's stamp, from the ego's pose then;
+   * each point is in the lidar frame of its own firing and carries its time (ScanFrame, the bag's `time` field).
+   * Objects stay where they are at the stamp.
+   */
+  bool rolling_sweep = false;
 
   /// Number of azimuths of a scan (fov / resolution, + 1 when the fov is not a full turn).
   int numAzimuths() const;

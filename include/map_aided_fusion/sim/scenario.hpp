@@ -85,6 +85,27 @@ struct LocalisationError
   double reportedSigma() const;
 };
 
+/**
+ * @brief A ground that is not flat, and an ego that pitches. The terrain height at (x, y), map frame, is
+ *        h = grade · grade_length / 2π · sin(2π x / grade_length) (rolling hills along x, steepest slope = grade)
+ *        − camber · min(d, camber_width), d the distance to the ego's route (the road's crown).
+ *
+ * The ego's body follows the terrain's slope at its position (pitch and roll over its wheelbase), plus a pitch
+ * oscillation of pitch_amplitude_deg and period pitch_period (braking, bumps); the lidar is fixed to the body,
+ * while the published tf stays level. Rays are cast in the flat world with the body's tilt, and every return is
+ * raised by the terrain height at its (x, y) relative to the ego's (buildings and objects stand on the terrain).
+ */
+struct Terrain
+{
+  double grade = 0.0;            ///< steepest slope of the hills (rise / run), [0, 0.3]
+  double grade_length = 200.0;   ///< m, wavelength of the hills, [10, 10000]
+  double camber = 0.0;           ///< cross fall from the crown (rise / run), [0, 0.2]
+  double camber_width = 7.0;     ///< m, the fall stops this far from the crown (the kerb), [0, 100]
+  double pitch_amplitude_deg = 0.0;  ///< deg, [0, 10]
+  double pitch_period = 3.0;         ///< s, [0.1, 1000]
+  bool any() const { return grade > 0.0 || camber > 0.0 || pitch_amplitude_deg > 0.0; }
+};
+
 /// Ground-truth raster parameters.
 struct GroundTruthParams
 {
@@ -118,6 +139,7 @@ struct Scenario
   std::vector<ObjectSpec> objects;
   MapErrors map_errors;
   LocalisationError localisation_error;
+  Terrain terrain;
   GroundTruthParams ground_truth;
   SceneParams scene;
 

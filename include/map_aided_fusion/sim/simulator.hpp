@@ -28,6 +28,7 @@ struct LidarPoint
   float x = 0.0f, y = 0.0f, z = 0.0f;
   float intensity = 0.0f;
   std::uint16_t ring = 0;  ///< beam index, 0 = lowest elevation
+  float time = 0.0f;       ///< s after the scan's stamp (0 unless lidar.rolling_sweep)
 };
 
 /// A planar pose (map frame).
@@ -109,6 +110,10 @@ public:
   double egoSpeed(double t) const;
   /// Pose of the lidar in the map frame for an ego pose.
   Pose2 lidarPose(const Pose2& ego) const;
+  /// Terrain height at (x, y) of the map frame (Terrain), m.
+  double terrainHeight(double x, double y) const;
+  /// The ego body's pitch (positive: nose down, about base_link y) and roll (about x), radians, at time @p t.
+  void bodyAttitude(double t, double& pitch, double& roll) const;
 
   /// Objects present at time @p t, as solids and as ground-truth records (same order).
   void objectsAt(double t, std::vector<WorldObject>& solids, std::vector<ObjectTruth>& truth) const;
@@ -124,7 +129,7 @@ private:
   std::unique_ptr<PathMotion> ego_motion_;
   std::vector<PathMotion> object_motion_;
   // per-beam constants
-  std::vector<double> slopes_, max_s_, cos_e_, sin_e_;
+  std::vector<double> slopes_, max_s_, cos_e_, sin_e_, tilted_slopes_;
   std::vector<BeamHit> hits_;
   std::vector<std::uint8_t> observed_;
   std::vector<WorldObject> solids_;

@@ -1,0 +1,140 @@
+// rostest (test/pcl_filters.test): launch/pcl_filters.launch composes pcl/CropBox and pcl/VoxelGrid ahead of the
+// ScanGridNodelet in one manager. A cloud with returns from the vehicle's own body and a dense wall goes in: the
+// body's returns never reach the grid, the wall is thinned by the voxel grid and still occupies its cells.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <vector>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+namespace {
+
+constexpr double kTimeout = 30.0;  // s
+constexpr float kLidarHeight = 1.8f;
+constexpr int kOccupiedAbove = 50;
+
+sensor_msgs::PointField field(const std::string& name, std::uint32_t offset)
+{
+  sensor_msgs::PointField f;
+  f.name = name;
+  f.offset = offset;
+  f.datatype = sensor_msgs::PointField::FLOAT32;
+  f.count = 1;
+  return f;
+}
+
+struct Point
+{
+  float x, y, z, intensity;
+};
+
+/// Body returns (inside the launch file's default box, 0.8 m above the ground) and a wall 10 m ahead sampled
+/// every 2 cm, in the lidar frame.
+std::vector<Point> scene()
+{
+  std::vector<Point> pts;
+  for (float x = -2.0f; x <= 2.5f; x += 0.1f)
+    for (float y = -1.0f; y <= 1.0f; y += 0.1f) pts.push_back({ x, y, 0.8f - kLidarHeight, 10.0f });
+  for (float y = -2.0f; y <= 2.0f; y += 0.02f)
+    for (float z = -1.2f; z <= -0.2f; z += 0.02f) pts.push_back({ 10.1f, y, z, 50.0f });
+  return pts;
+}
+
+sensor_msgs::PointCloud2Ptr cloud(const std::vector<Point>& pts, const ros::Time& stamp)
+{
+  auto c = boost::make_shared<sensor_msgs::PointCloud2>();
+  c->header.stamp = stamp;
+  c->header.frame_id = "lidar";
+  c->fields = { field("x", 0), field("y", 4), field("z", 8), field("intensity", 12) };
+  c->point_step = sizeof(Point);
+  c->height = 1;
+  c->width = static_cast<std::uint32_t>(pts.size());
+  c->row_step = c->width * c->point_step;
+  c->is_dense = true;
+  c->data.resize(c->row_step);
+  std::memcpy(c->data.data(), pts.data(), c->row_step);
+  return c;
+}
+
+int cellAt(const nav_msgs::OccupancyGrid& g, double x, double y)
+{
+  const int cx = static_cast<int>(std::floor((x - g.info.origin.position.x) / g.info.resolution));
+  const int cy = static_cast<int>(std::floor((y - g.info.origin.position.y) / g.info.resolution));
+  return g.data[static_cast<std::size_t>(cy) * g.info.width + static_cast<std::size_t>(cx)];
+}
+
+}  // namespace
+
+TEST(PclFilters, CropBoxAndVoxelGridFeedTheScanGridInOneManager)
+{
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster tf;
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time::now();
+  t.header.frame_id = "base_link";
+  t.child_frame_id = "lidar";
+  t.transform.translation.z = kLidarHeight;
+  t.transform.rotation.w = 1.0;
+  tf.sendTransform(t);
+
+  std::mutex m;
+  sensor_msgs::PointCloud2ConstPtr filtered;
+  nav_msgs::OccupancyGridConstPtr grid;
+  ros::Subscriber filtered_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "voxel_grid/output", 1, [&](const sensor_msgs::PointCloud2ConstPtr& c) {
+        std::lock_guard<std::mutex> lock(m);
+        filtered = c;
+      });
+  ros::Subscriber grid_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "scan_grid/occupancy", 1, [&](const nav_msgs::OccupancyGridConstPtr& g) {
+        std::lock_guard<std::mutex> lock(m);
+        grid = g;
+      });
+  ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("points_raw", 1);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+
+  const std::vector<Point> pts = scene();
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(kTimeout);
+  bool done = false;
+  while (ros::ok() && ros::WallTime::now() < end && !done)
+  {
+    pub.publish(cloud(pts, ros::Time::now()));
+    ros::WallDuration(0.2).sleep();
+    std::lock_guard<std::mutex> lock(m);
+    done = filtered && grid;
+  }
+  ASSERT_TRUE(done) << "no filtered cloud or no grid within " << kTimeout << " s";
+  std::lock_guard<std::mutex> lock(m);
+
+  // The voxel grid thinned the 10 000 wall returns (10 cm voxels: about 40 × 10) and the crop removed the body.
+  EXPECT_LT(filtered->width * filtered->height, pts.size() / 5);
+  EXPECT_GT(filtered->width * filtered->height, 100u);
+  std::size_t body = 0;
+  for (std::size_t i = 0; i < filtered->width * filtered->height; ++i)
+  {
+    float x;
+    std::memcpy(&x, filtered->data.data() + i * filtered->point_step, sizeof x);
+    body += x < 5.0f;
+  }
+  EXPECT_EQ(body, 0u);
+
+  // The wall occupies its cells; the body's would be occupied without the crop.
+  EXPECT_GT(cellAt(*grid, 10.25, 0.0), kOccupiedAbove);
+  EXPECT_LT(cellAt(*grid, 2.25, 0.25), kOccupiedAbove);
+  EXPECT_LT(cellAt(*grid, -1.75, 0.25), kOccupiedAbove);
+}
+
+int main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "pcl_filters_rostest_node");
+  return RUN_ALL_TESTS();
+}
