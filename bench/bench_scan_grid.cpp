@@ -91,12 +91,15 @@ ScanGridParams spinningParams()
   return p;
 }
 
-void BM_ScanGrid(benchmark::State& state)
+/// The 64-beam street cloud of @p state.range(0) points into the 160 m grid with @p ground_model.
+void scanGrid(benchmark::State& state, const char* ground_model)
 {
   const std::size_t n = static_cast<std::size_t>(state.range(0));
   const double h = 1.8;
   const auto cloud = makeCloud(n, 64, -25.0, 15.0, -kPi, 2.0 * kPi, h);
-  ScanGridBuilder builder(spinningParams(), sensorAt(0.9, h));
+  ScanGridParams p = spinningParams();
+  p.ground_model = ground_model;
+  ScanGridBuilder builder(p, sensorAt(0.9, h));
   ScanMassGrid grid(builder.geometry());
   ScanGridStats st;
   const PointCloudView v = PointCloudView::packed(cloud.data(), n, kVelodyneStep);
@@ -108,29 +111,14 @@ void BM_ScanGrid(benchmark::State& state)
   state.counters["cells"] = static_cast<double>(grid.numCells());
   state.counters["occupied"] = static_cast<double>(st.occupied_cells);
   state.counters["free"] = static_cast<double>(st.free_cells);
+  state.counters["zones_fitted"] = static_cast<double>(st.ground_fit.fitted);
   state.counters["points/s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate);
 }
+
+void BM_ScanGrid(benchmark::State& state) { scanGrid(state, "flat"); }
 BENCHMARK(BM_ScanGrid)->Arg(0)->Arg(130000)->Arg(260000)->Unit(benchmark::kMillisecond);
 
-void BM_ScanGridGround(benchmark::State& state)
-{
-  const std::size_t n = static_cast<std::size_t>(state.range(0));
-  const double h = 1.8;
-  const auto cloud = makeCloud(n, 64, -25.0, 15.0, -kPi, 2.0 * kPi, h);
-  ScanGridParams p = spinningParams();
-  p.ground_model = "planes";
-  ScanGridBuilder builder(p, sensorAt(0.9, h));
-  ScanMassGrid grid(builder.geometry());
-  ScanGridStats st;
-  const PointCloudView v = PointCloudView::packed(cloud.data(), n, kVelodyneStep);
-  for (auto _ : state)
-  {
-    builder.build(v, grid, &st);
-    benchmark::DoNotOptimize(grid.plane(FrameSG::kO));
-  }
-  state.counters["occupied"] = static_cast<double>(st.occupied_cells);
-  state.counters["zones_fitted"] = static_cast<double>(st.ground_fit.fitted);
-}
+void BM_ScanGridGround(benchmark::State& state) { scanGrid(state, "planes"); }
 BENCHMARK(BM_ScanGridGround)->Arg(130000)->Unit(benchmark::kMillisecond);
 
 void BM_Deskew(benchmark::State& state)
@@ -161,7 +149,10 @@ void BM_ScanGridPaper(benchmark::State& state)
   // IBEO Alaska XT at the front bumper: 4 layers over 3.2°, ~110° wide.
   const double span = 110.0 * kPi / 180.0;
   const auto cloud = makeCloud(n, 4, -1.6, 1.6, -0.5 * span, span, h);
-  ScanGridParams p;  // the defaults of config/scan_grid.yaml: 100 m × 100 m at 0.5 m
+  ScanGridParams p;  // config/ibeo/scan_grid.yaml: 100 m × 100 m at 0.5 m, 0.5° sectors, flat ground
+  p.azimuth_resolution_deg = 0.5;
+  p.ground_model = "flat";
+  p.relative_height_limit = 0.0;
   ScanGridBuilder builder(p, sensorAt(3.5, h));
   ScanMassGrid grid(builder.geometry());
   ScanGridStats st;

@@ -314,6 +314,34 @@ std::string toMarkdown(const std::vector<VariantScores>& variants)
   }
   out << "\n";
   for (const auto& v : variants) out << "- **" << v.name << "**: " << v.description << "\n";
+
+  // Where V goes wrong: cells decided V whose truth is another class, per scan, and facades decided S or V.
+  out << "\nFalse V (cells decided V whose truth is another class) per scan, by true class; facade (truth C) cells "
+         "decided S or V:\n\n";
+  out << "| variant | on F (road, free ground) | on C (facades) | on N | on S | total | facade S or V |\n";
+  out << "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  constexpr int kBuildingClass = static_cast<int>(CellClass::kBuilding);
+  for (const auto& v : variants)
+  {
+    const double scans = static_cast<double>(std::max<std::uint64_t>(1, v.scans));
+    out << "| " << v.name;
+    std::uint64_t total = 0;
+    for (const int c : { kFree, kBuildingClass, static_cast<int>(CellClass::kInfrastructure), kStopped })
+    {
+      total += v.confusion.count(c, kMoving);
+      std::snprintf(buf, sizeof buf, "%.2f", static_cast<double>(v.confusion.count(c, kMoving)) / scans);
+      out << " | " << buf;
+    }
+    std::snprintf(buf, sizeof buf, "%.2f", static_cast<double>(total) / scans);
+    out << " | " << buf;
+    const std::uint64_t facade = v.confusion.support(kBuildingClass);
+    std::snprintf(buf, sizeof buf, "%.1f %%",
+                  facade ? 100.0 * static_cast<double>(v.confusion.count(kBuildingClass, kStopped) +
+                                                       v.confusion.count(kBuildingClass, kMoving)) /
+                               static_cast<double>(facade) :
+                           0.0);
+    out << " | " << buf << " |\n";
+  }
   return out.str();
 }
 

@@ -132,6 +132,12 @@ TEST(Reports, JsonAndMarkdownCarryTheNamedMetrics)
   const auto json = toJson({ v }, { { "scenario", "test" } });
   EXPECT_NE(json.find("\"moving.recall\": 0.75"), std::string::npos) << json;
   EXPECT_NE(json.find("\"scenario\": \"test\""), std::string::npos);
+  v.confusion.add(0, 4, 6);  // free cells decided V
+  v.confusion.add(1, 3, 1);  // a facade cell decided S
+  v.confusion.add(1, 1, 3);
+  v.scans = 2;
   const auto md = toMarkdown({ v });
   EXPECT_NE(md.find("| full |"), std::string::npos) << md;
+  // False V per scan: 6 free cells over 2 scans; 1 of 4 facade cells decided S or V.
+  EXPECT_NE(md.find("| full | 3.00 | 0.00 | 0.00 | 0.00 | 3.00 | 25.0 % |"), std::string::npos) << md;
 }

@@ -12,6 +12,10 @@
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include "cloud_helpers.hpp"
+
+using namespace map_aided_fusion;
+
 namespace {
 
 constexpr double kTimeout = 30.0;  // s
@@ -33,32 +37,7 @@ sensor_msgs::PointCloud2Ptr ibeoCloud(const ros::Time& stamp)
       xyz.insert(xyz.end(), { static_cast<float>(kWall), static_cast<float>(kWall * std::tan(a)),
                               static_cast<float>(r * std::sin(e)) });
     }
-  auto c = boost::make_shared<sensor_msgs::PointCloud2>();
-  c->header.stamp = stamp;
-  c->header.frame_id = "ibeo_lux";
-  for (const char* name : { "x", "y", "z" })
-  {
-    sensor_msgs::PointField f;
-    f.name = name;
-    f.offset = static_cast<std::uint32_t>(4 * c->fields.size());
-    f.datatype = sensor_msgs::PointField::FLOAT32;
-    f.count = 1;
-    c->fields.push_back(f);
-  }
-  c->point_step = 12;
-  c->height = 1;
-  c->width = static_cast<std::uint32_t>(xyz.size() / 3);
-  c->row_step = c->width * c->point_step;
-  c->data.resize(c->row_step);
-  std::memcpy(c->data.data(), xyz.data(), c->row_step);
-  return c;
-}
-
-int cellAt(const nav_msgs::OccupancyGrid& g, double x, double y)
-{
-  const int cx = static_cast<int>(std::floor((x - g.info.origin.position.x) / g.info.resolution));
-  const int cy = static_cast<int>(std::floor((y - g.info.origin.position.y) / g.info.resolution));
-  return g.data[static_cast<std::size_t>(cy) * g.info.width + static_cast<std::size_t>(cx)];
+  return test::packedCloud({ "x", "y", "z" }, xyz, "ibeo_lux", stamp);
 }
 
 }  // namespace
@@ -90,10 +69,10 @@ TEST(Ibeo, TheLaunchFileWiresTheDriversTopicFrameAndMount)
   EXPECT_EQ(grid->header.frame_id, "base_link");
   EXPECT_DOUBLE_EQ(grid->info.resolution, 0.5);
   EXPECT_EQ(grid->info.width, 200u) << "the paper's 100 m window";
-  EXPECT_GT(cellAt(*grid, kMountX + kWall + 0.1, 0.1), kOccupiedAbove);
-  EXPECT_GE(cellAt(*grid, kMountX + 0.5 * kWall, 0.1), 0);
-  EXPECT_LT(cellAt(*grid, kMountX + 0.5 * kWall, 0.1), kOccupiedAbove) << "free between the bumper and the wall";
-  EXPECT_EQ(cellAt(*grid, -10.0, 0.1), -1) << "nothing is seen behind the car";
+  EXPECT_GT(test::occupancyAt(*grid, kMountX + kWall + 0.1, 0.1), kOccupiedAbove);
+  EXPECT_GE(test::occupancyAt(*grid, kMountX + 0.5 * kWall, 0.1), 0);
+  EXPECT_LT(test::occupancyAt(*grid, kMountX + 0.5 * kWall, 0.1), kOccupiedAbove) << "free between the bumper and the wall";
+  EXPECT_EQ(test::occupancyAt(*grid, -10.0, 0.1), -1) << "nothing is seen behind the car";
 }
 
 int main(int argc, char** argv)

@@ -14,21 +14,15 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "cloud_helpers.hpp"
+
+using namespace map_aided_fusion;
+
 namespace {
 
 constexpr double kTimeout = 30.0;  // s
 constexpr float kLidarHeight = 1.8f;
 constexpr int kOccupiedAbove = 50;
-
-sensor_msgs::PointField field(const std::string& name, std::uint32_t offset)
-{
-  sensor_msgs::PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = sensor_msgs::PointField::FLOAT32;
-  f.count = 1;
-  return f;
-}
 
 struct Point
 {
@@ -49,25 +43,9 @@ std::vector<Point> scene()
 
 sensor_msgs::PointCloud2Ptr cloud(const std::vector<Point>& pts, const ros::Time& stamp)
 {
-  auto c = boost::make_shared<sensor_msgs::PointCloud2>();
-  c->header.stamp = stamp;
-  c->header.frame_id = "lidar";
-  c->fields = { field("x", 0), field("y", 4), field("z", 8), field("intensity", 12) };
-  c->point_step = sizeof(Point);
-  c->height = 1;
-  c->width = static_cast<std::uint32_t>(pts.size());
-  c->row_step = c->width * c->point_step;
-  c->is_dense = true;
-  c->data.resize(c->row_step);
-  std::memcpy(c->data.data(), pts.data(), c->row_step);
-  return c;
-}
-
-int cellAt(const nav_msgs::OccupancyGrid& g, double x, double y)
-{
-  const int cx = static_cast<int>(std::floor((x - g.info.origin.position.x) / g.info.resolution));
-  const int cy = static_cast<int>(std::floor((y - g.info.origin.position.y) / g.info.resolution));
-  return g.data[static_cast<std::size_t>(cy) * g.info.width + static_cast<std::size_t>(cx)];
+  std::vector<float> floats;
+  for (const Point& p : pts) floats.insert(floats.end(), { p.x, p.y, p.z, p.intensity });
+  return test::packedCloud({ "x", "y", "z", "intensity" }, floats, "lidar", stamp);
 }
 
 }  // namespace
@@ -127,9 +105,9 @@ TEST(PclFilters, CropBoxAndVoxelGridFeedTheScanGridInOneManager)
   EXPECT_EQ(body, 0u);
 
   // The wall occupies its cells; the body's would be occupied without the crop.
-  EXPECT_GT(cellAt(*grid, 10.25, 0.0), kOccupiedAbove);
-  EXPECT_LT(cellAt(*grid, 2.25, 0.25), kOccupiedAbove);
-  EXPECT_LT(cellAt(*grid, -1.75, 0.25), kOccupiedAbove);
+  EXPECT_GT(test::occupancyAt(*grid, 10.25, 0.0), kOccupiedAbove);
+  EXPECT_LT(test::occupancyAt(*grid, 2.25, 0.25), kOccupiedAbove);
+  EXPECT_LT(test::occupancyAt(*grid, -1.75, 0.25), kOccupiedAbove);
 }
 
 int main(int argc, char** argv)

@@ -14,21 +14,13 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "cloud_helpers.hpp"
 #include "map_aided_fusion/EvidentialGrid.h"
 
 namespace {
 
 constexpr double kTimeout = 15.0;  // s
 
-sensor_msgs::PointField field(const std::string& name, std::uint32_t offset)
-{
-  sensor_msgs::PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = sensor_msgs::PointField::FLOAT32;
-  f.count = 1;
-  return f;
-}
 
 /// A wall 10 m ahead of the lidar, 1 m above the ground (the lidar is 1.8 m up), fields x y z intensity.
 sensor_msgs::PointCloud2Ptr wallCloud(const ros::Time& stamp)
@@ -36,7 +28,8 @@ sensor_msgs::PointCloud2Ptr wallCloud(const ros::Time& stamp)
   auto c = boost::make_shared<sensor_msgs::PointCloud2>();
   c->header.stamp = stamp;
   c->header.frame_id = "lidar";
-  c->fields = { field("x", 0), field("y", 4), field("z", 8), field("intensity", 12) };
+  using map_aided_fusion::test::floatField;
+  c->fields = { floatField("x", 0), floatField("y", 4), floatField("z", 8), floatField("intensity", 12) };
   c->point_step = 16;
   c->height = 1;
   c->width = 101;

@@ -10,6 +10,7 @@
 
 #include "map_aided_fusion/ros/cloud_deskew.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
+#include "cloud_helpers.hpp"
 
 using namespace map_aided_fusion;
 using sensor_msgs::PointField;
@@ -20,16 +21,6 @@ constexpr double kStamp = 100.0;     // s
 constexpr double kSpeed = 10.0;      // m/s along the map's x
 constexpr double kWall = 20.0;       // m, x of a wall in the map frame
 
-PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type)
-{
-  PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = type;
-  f.count = 1;
-  return f;
-}
-
 /// A Velodyne-style sweep (x y z float32, time float32 at 12) of a wall at x = kWall from a lidar moving at kSpeed:
 /// point k taken at τ = k / 100 · 0.1 s.
 sensor_msgs::PointCloud2 sweep(const std::string& time_name = "time", std::uint8_t time_type = PointField::FLOAT32)
@@ -37,8 +28,8 @@ sensor_msgs::PointCloud2 sweep(const std::string& time_name = "time", std::uint8
   sensor_msgs::PointCloud2 c;
   c.header.frame_id = "lidar";
   c.header.stamp.fromSec(kStamp);
-  c.fields = { field("x", 0, PointField::FLOAT32), field("y", 4, PointField::FLOAT32), field("z", 8, PointField::FLOAT32),
-               field(time_name, 12, time_type) };
+  c.fields = { test::floatField("x", 0), test::floatField("y", 4), test::floatField("z", 8),
+               pointField(time_name, 12, time_type) };
   c.point_step = 16;
   c.width = 100;
   c.height = 1;

@@ -5,6 +5,7 @@
 
 #include <sensor_msgs/PointField.h>
 
+#include "cloud_helpers.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
 
 using namespace map_aided_fusion;
@@ -12,22 +13,13 @@ using sensor_msgs::PointField;
 
 namespace {
 
-PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type = PointField::FLOAT32)
-{
-  PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = type;
-  f.count = 1;
-  return f;
-}
-
 /// An unorganized cloud with fields intensity, x, y, z (x at offset 4) and 20-byte points.
 sensor_msgs::PointCloud2 cloud(const std::vector<std::array<float, 3>>& pts)
 {
   sensor_msgs::PointCloud2 c;
   c.header.frame_id = "lidar";
-  c.fields = { field("intensity", 0), field("x", 4), field("y", 8), field("z", 12), field("ring", 16, PointField::UINT16) };
+  c.fields = { test::floatField("intensity", 0), test::floatField("x", 4), test::floatField("y", 8),
+               test::floatField("z", 12), pointField("ring", 16, PointField::UINT16) };
   c.point_step = 20;
   c.width = static_cast<std::uint32_t>(pts.size());
   c.height = 1;

@@ -50,7 +50,7 @@ constexpr int kGroundRansacIterations = 60;
 struct GroundModelParams
 {
   int sectors = 8;                ///< azimuth sectors per ring, in [1, 64]
-  double max_slope_deg = 15.0;    ///< a fitted normal further from vertical is a wall, deg, in [0, 60]
+  double max_slope_deg = 5.0;     ///< a fitted normal further from vertical is refused, deg, in [0, 60]
   int min_points = 20;            ///< candidates and inliers a zone needs, in [3, 100000]
   double search_band = 0.6;       ///< m, candidates lie within this of the predicted ground, (0, 10]
   double fit_tolerance = 0.08;    ///< m, RANSAC inlier distance, (0, search_band]

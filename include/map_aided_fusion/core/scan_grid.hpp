@@ -105,7 +105,7 @@ struct ScanGridParams
   /// Step "ground model" (not in the paper): `flat` (z = ground_height) or `planes` (core/ground_model.hpp).
   std::string ground_model = "planes";
   int ground_sectors = 8;               ///< azimuth sectors per ring of the `planes` model, in [1, 64]
-  double ground_max_slope_deg = 15.0;   ///< a fitted plane steeper than this is a wall, not ground, deg, [0, 60]
+  double ground_max_slope_deg = 5.0;    ///< a fitted plane steeper than this (against the body) is refused, deg, [0, 60]
   int ground_min_points = 20;           ///< candidates and inliers a zone's fit needs, in [3, 100000]
   double ground_search_band = 0.6;      ///< m, a zone's candidates lie within this of the predicted ground, (0, 10]
   double ground_fit_tolerance = 0.08;   ///< m, RANSAC inlier distance, (0, ground_search_band]
