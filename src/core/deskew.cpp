@@ -104,7 +104,13 @@ DeskewOutcome deskew(const PointCloudView& points, const PointTimeField& time, d
   double span = 0.0;
   const DeskewOutcome checked = sweepSpan(points, time, reference, max_sweep_duration, span);
   if (checked != DeskewOutcome::kApplied) return checked;
+  deskewChecked(points, time, reference, motion, span, out_xyz, out_view);
+  return DeskewOutcome::kApplied;
+}
 
+void deskewChecked(const PointCloudView& points, const PointTimeField& time, double reference,
+                   const SweepMotion& motion, double span, std::vector<float>& out_xyz, PointCloudView& out_view)
+{
   // Table of interpolated transforms over [0, span] (offsets are within it).
   const double step = span / (kDeskewSteps - 1);
   std::vector<std::array<float, 12>> table(kDeskewSteps);
@@ -135,17 +141,14 @@ DeskewOutcome deskew(const PointCloudView& points, const PointTimeField& time, d
         const float x = readFloat(p + points.x_offset);
         const float y = readFloat(p + points.y_offset);
         const float z = readFloat(p + points.z_offset);
-        if (x == 0.0f && y == 0.0f && z == 0.0f)
-        {
-          out[0] = out[1] = out[2] = 0.0f;
-          continue;
-        }
-        // Non-finite coordinates stay non-finite through the transform (the ScanGrid rejects them).
+        // (0, 0, 0) "no return" stays (0, 0, 0) (selected without a branch: a third of a sweep can be such points);
+        // non-finite coordinates stay non-finite through the transform (the ScanGrid rejects them).
+        const float keep = (x == 0.0f && y == 0.0f && z == 0.0f) ? 0.0f : 1.0f;
         const int k = std::clamp(index_of(p + time.offset), 0, kDeskewSteps - 1);
         const float* m = table[static_cast<std::size_t>(k)].data();
-        out[0] = m[0] * x + m[1] * y + m[2] * z + m[3];
-        out[1] = m[4] * x + m[5] * y + m[6] * z + m[7];
-        out[2] = m[8] * x + m[9] * y + m[10] * z + m[11];
+        out[0] = keep * (m[0] * x + m[1] * y + m[2] * z + m[3]);
+        out[1] = keep * (m[4] * x + m[5] * y + m[6] * z + m[7]);
+        out[2] = keep * (m[8] * x + m[9] * y + m[10] * z + m[11]);
       }
     }
   };
@@ -164,7 +167,6 @@ DeskewOutcome deskew(const PointCloudView& points, const PointTimeField& time, d
       break;
   }
   out_view = PointCloudView::packed(out_xyz.data(), n, 3 * sizeof(float));
-  return DeskewOutcome::kApplied;
 }
 
 }  // namespace core

@@ -148,10 +148,15 @@ DeskewResult CloudDeskewer::apply(const sensor_msgs::PointCloud2& cloud, const c
     r.status = "no_motion";
     return r;
   }
-  const core::DeskewOutcome done = core::deskew(view, field, stamp, motion, max_sweep_duration, buffer_, out);
-  r.status = core::toString(done);
-  r.applied = done == core::DeskewOutcome::kApplied;
-  if (!r.applied) out = view;
+  if (!motion.delta.matrix().allFinite())
+  {
+    r.status = core::toString(core::DeskewOutcome::kBadMotion);
+    r.detail = "tf gave a non-finite motion for frame '" + cloud.header.frame_id + "'";
+    return r;
+  }
+  core::deskewChecked(view, field, stamp, motion, r.span, buffer_, out);
+  r.status = core::toString(core::DeskewOutcome::kApplied);
+  r.applied = true;
   return r;
 }
 

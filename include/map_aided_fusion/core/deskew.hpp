@@ -88,6 +88,13 @@ DeskewOutcome deskew(const PointCloudView& points, const PointTimeField& time, d
                      const SweepMotion& motion, double max_sweep_duration, std::vector<float>& out_xyz,
                      PointCloudView& out_view);
 
+/**
+ * @brief deskew() without the checks: @p span is what sweepSpan() returned kApplied with for these points, and
+ *        @p motion is finite with a non-zero duration. For callers that ran sweepSpan() already (one pass less).
+ */
+void deskewChecked(const PointCloudView& points, const PointTimeField& time, double reference,
+                   const SweepMotion& motion, double span, std::vector<float>& out_xyz, PointCloudView& out_view);
+
 /// Interpolated transform at fraction @p alpha of @p delta (α = 0: identity, α = 1: delta).
 Eigen::Isometry3d interpolateMotion(const Eigen::Isometry3d& delta, double alpha);
 

@@ -90,8 +90,8 @@ public:
   void configure(const GroundModelParams& params);
 
   int numZones() const { return kGroundRings * sectors_; }
-  /// Zone of a return at (dx, dy) from the sensor, r2 = dx² + dy², with azimuth sector @p azimuth_fraction in
-  /// [0, 1) of the full turn from −180°.
+  /// Zone of a return at (dx, dy) from the sensor, r2 = dx² + dy², whose direction is @p azimuth_fraction in [0, 1)
+  /// of the turn (any monotonic measure of the azimuth; the ScanGrid's is exact at multiples of 45°).
   int zoneOf(float r2, float azimuth_fraction) const
   {
     int ring = 0;

@@ -311,7 +311,6 @@ private:
   GroundModel ground_kind_ = GroundModel::kFlat;
   std::vector<float> valid_dx_, valid_dy_, valid_z_;
   std::vector<std::uint16_t> valid_zone_;
-  std::vector<std::uint32_t> valid_sector_;
   GroundPlaneFitter ground_;
 };
 
