@@ -16,6 +16,10 @@ if(MAF_PCL_ROS_FILTERS)
   file(MAKE_DIRECTORY ${CATKIN_DEVEL_PREFIX}/lib)
   execute_process(COMMAND ${CMAKE_COMMAND} -E create_symlink ${MAF_PCL_ROS_FILTERS}
                   ${CATKIN_DEVEL_PREFIX}/lib/libpcl_ros_filters.so)
+  # The same link in an install space (catkin_make install).
+  install(CODE "file(MAKE_DIRECTORY \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/lib\")
+    execute_process(COMMAND \"${CMAKE_COMMAND}\" -E create_symlink \"${MAF_PCL_ROS_FILTERS}\"
+                    \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/lib/libpcl_ros_filters.so\")")
 else()
   message(WARNING "pcl_ros filters library not found: launch/pcl_filters.launch will not load (scripts/common.sh)")
 endif()
