@@ -1,7 +1,8 @@
 #include "map_aided_fusion/ros/cloud_deskew.hpp"
 
-#include <Eigen/Geometry>
 #include <sensor_msgs/PointField.h>
+
+#include "map_aided_fusion/ros/tf_helpers.hpp"
 
 namespace map_aided_fusion {
 
@@ -27,24 +28,15 @@ const KnownField kKnownFields[] = {
   { "offset_time", sensor_msgs::PointField::UINT32, core::TimeEncoding::kUint32, kNanosecond, false },
 };
 
-Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
-{
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translate(Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z));
-  pose.rotate(Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized());
-  return pose;
-}
-
-std::string tfFrame(const std::string& frame)
-{
-  return frame.empty() || frame[0] != '/' ? frame : frame.substr(1);
-}
-
 }  // namespace
 
 const std::vector<std::string>& knownTimeFields()
 {
-  static const std::vector<std::string> names{ "time", "t", "timestamp", "offset_time" };
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const KnownField& k : kKnownFields) n.emplace_back(k.name);
+    return n;
+  }();
   return names;
 }
 

@@ -11,6 +11,7 @@
 #include "map_aided_fusion/ros/conversions.hpp"
 #include "map_aided_fusion/ros/param_loading.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
+#include "map_aided_fusion/ros/tf_helpers.hpp"
 
 namespace map_aided_fusion {
 
@@ -23,12 +24,6 @@ constexpr double kMinJumpThreshold = 0.001;
 constexpr double kMaxJumpThreshold = 3600.0;
 /// Wall period of the clock watch (backward /clock jumps), s.
 constexpr double kClockCheckPeriod = 0.1;
-
-/// A frame id as tf2 knows it: tf1-style "/lidar" without its leading slash.
-std::string tfFrame(const std::string& frame)
-{
-  return frame.empty() || frame[0] != '/' ? frame : frame.substr(1);
-}
 
 /// The reconfigurable fields of @p m, written into @p c (what the server then shows and replies).
 void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
@@ -46,14 +41,6 @@ void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
   c.free_margin = m.free_margin;
   c.deskew = m.deskew;
   c.ground_model = m.ground_model;
-}
-
-Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t)
-{
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translate(Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z));
-  pose.rotate(Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized());
-  return pose;
 }
 
 }  // namespace
@@ -270,7 +257,7 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
                       params_.model.deskew_max_sweep_duration, *tf_buffer_, params_.deskew_fixed_frame, view);
   ++deskew_counts_[deskew.status];
   last_deskew_ = deskew.status;
-  if (!deskew.applied && deskew.status != "off" && deskew.status != "no_time_field")
+  if (deskew.skipped())
   {
     deskew_skipped_window_.add(core::steadySeconds());
     if (deskew_warned_.insert(deskew.status).second)

@@ -32,6 +32,9 @@ struct DeskewResult
   std::string status;
   std::string detail;  ///< for logs
   double span = 0.0;   ///< s, the latest point time after the stamp
+
+  /// True when the cloud had to be left as it is for a fault (not "off", not "no_time_field"): counted and warned.
+  bool skipped() const { return !applied && status != "off" && status != "no_time_field"; }
 };
 
 /**
