@@ -1,49 +1,15 @@
 #!/usr/bin/env python3
 """Writes maps/town.osm: a small fictional town laid out in local ENU metres around ORIGIN and
-converted to WGS84 (ellipsoidal local tangent plane, first order: error < 1 mm over 200 m).
+converted to WGS84 (osm_layout.py).
 Run it only to change the town; the .osm file is what the package uses."""
 import math
 import sys
 
+from osm_layout import OsmLayout, rect
+
 ORIGIN = (49.4150, 2.8230, 40.0)  # lat, lon (degrees), altitude (m)
-A, F = 6378137.0, 1 / 298.257223563
-E2 = F * (2 - F)
-
-
-def to_latlon(x, y):
-    lat0 = math.radians(ORIGIN[0])
-    s = math.sin(lat0)
-    n = A / math.sqrt(1 - E2 * s * s)            # prime vertical radius
-    m = A * (1 - E2) / (1 - E2 * s * s) ** 1.5   # meridian radius
-    return ORIGIN[0] + math.degrees(y / m), ORIGIN[1] + math.degrees(x / (n * math.cos(lat0)))
-
-
-nodes, ways, relations = [], [], []
-next_id = [1000]
-
-
-def nid():
-    next_id[0] += 1
-    return next_id[0]
-
-
-def node(x, y):
-    i = nid()
-    nodes.append((i, *to_latlon(x, y)))
-    return i
-
-
-def way(points, tags, closed=False):
-    refs = [node(x, y) for x, y in points]
-    if closed:
-        refs.append(refs[0])
-    i = nid()
-    ways.append((i, refs, tags))
-    return i
-
-
-def rect(x0, y0, x1, y1):
-    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+town = OsmLayout(ORIGIN, "maps/generate_town.py")
+way, nid = town.way, town.nid
 
 
 # Roads: centre lines spanning the town. Surfaces: Main 10 m (width), North 2 lanes (7 m),
@@ -92,29 +58,7 @@ for pts, tags in buildings:
 # A multipolygon building with a courtyard (height 15 m).
 outer = way(rect(10, 12, 70, 70), {}, closed=True)
 inner = way(rect(25, 27, 55, 55), {}, closed=True)
-relations.append((nid(), [("way", outer, "outer"), ("way", inner, "inner")],
-                  {"type": "multipolygon", "building": "yes", "height": "15", "name": "Cloister"}))
+town.relation([("way", outer, "outer"), ("way", inner, "inner")],
+              {"type": "multipolygon", "building": "yes", "height": "15", "name": "Cloister"})
 
-lat_min, lon_min = to_latlon(-E, -E)
-lat_max, lon_max = to_latlon(E, E)
-out = sys.stdout
-out.write('<?xml version="1.0" encoding="UTF-8"?>\n')
-out.write('<osm version="0.6" generator="map_aided_fusion maps/generate_town.py">\n')
-out.write(f'  <bounds minlat="{lat_min:.7f}" minlon="{lon_min:.7f}" maxlat="{lat_max:.7f}" maxlon="{lon_max:.7f}"/>\n')
-for i, lat, lon in nodes:
-    out.write(f'  <node id="{i}" version="1" lat="{lat:.8f}" lon="{lon:.8f}"/>\n')
-for i, refs, tags in ways:
-    out.write(f'  <way id="{i}" version="1">\n')
-    for r in refs:
-        out.write(f'    <nd ref="{r}"/>\n')
-    for k, v in tags.items():
-        out.write(f'    <tag k="{k}" v="{v}"/>\n')
-    out.write('  </way>\n')
-for i, members, tags in relations:
-    out.write(f'  <relation id="{i}" version="1">\n')
-    for t, r, role in members:
-        out.write(f'    <member type="{t}" ref="{r}" role="{role}"/>\n')
-    for k, v in tags.items():
-        out.write(f'    <tag k="{k}" v="{v}"/>\n')
-    out.write('  </relation>\n')
-out.write('</osm>\n')
+town.write(sys.stdout, E)

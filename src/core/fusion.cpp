@@ -10,6 +10,27 @@ namespace core {
 
 using kernels::kSubsets;
 
+const char* toString(CombinationRule rule)
+{
+  switch (rule)
+  {
+    case CombinationRule::kYager:
+      return "yager";
+    case CombinationRule::kDempster:
+      return "dempster";
+    case CombinationRule::kModifiedYager:
+      break;
+  }
+  return "modified_yager";
+}
+
+CombinationRule parseCombinationRule(const std::string& name)
+{
+  for (CombinationRule r : { CombinationRule::kModifiedYager, CombinationRule::kYager, CombinationRule::kDempster })
+    if (name == toString(r)) return r;
+  throw ParameterError("combination_rule", "'" + name + "' is not modified_yager, yager or dempster");
+}
+
 CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG& scan, const MassMG& prior,
                           const FusionParams& params)
 {

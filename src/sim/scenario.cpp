@@ -2,8 +2,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -33,6 +35,22 @@ constexpr double kMaxPitchDeg = 10.0;
 constexpr double kMinPitchPeriod = 0.1;
 
 using core::ParameterError;
+
+/// @throws ParameterError naming the first key of the mapping @p n (at @p path) that is not in @p known.
+void requireKnownKeys(const YAML::Node& n, const std::string& path, std::initializer_list<const char*> known)
+{
+  if (!n || !n.IsMap()) return;
+  for (const auto& kv : n)
+  {
+    const std::string key = kv.first.as<std::string>();
+    if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; }))
+    {
+      std::string list;
+      for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      throw ParameterError(path + key, "is not a scenario key (here: " + list + ")");
+    }
+  }
+}
 
 template <class T>
 T get(const YAML::Node& n, const std::string& key, const std::string& path, const T& fallback)
@@ -100,6 +118,7 @@ void readMotion(const YAML::Node& n, const std::string& path, const std::vector<
   for (std::size_t i = 0; i < stops.size(); ++i)
   {
     const std::string sp = path + "stops[" + std::to_string(i) + "].";
+    requireKnownKeys(stops[i], sp, { "at", "s", "duration" });
     Stop st;
     if (stops[i]["at"]) st.s = geometry.project(toPoint(stops[i]["at"], sp + "at"));
     else if (stops[i]["s"]) st.s = get<double>(stops[i], "s", sp, 0.0);
@@ -260,6 +279,9 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
       if (kv.first.as<std::string>() != "base") merged[kv.first.as<std::string>()] = kv.second;
     root = merged;
   }
+  requireKnownKeys(root, "", { "name", "map", "map_origin", "duration", "seed", "default_building_height", "tf_rate_hz",
+                               "start_stamp", "lidar", "ground_truth", "scene", "ego", "map_errors",
+                               "localisation_error", "terrain", "objects" });
   Scenario sc;
   sc.name = get<std::string>(root, "name", "", sc.name);
   const std::string map = get<std::string>(root, "map", "", "");
@@ -282,6 +304,9 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
 
   if (const YAML::Node l = root["lidar"])
   {
+    requireKnownKeys(l, "lidar.", { "preset", "elevations_deg", "azimuth_resolution_deg", "fov_deg", "min_range",
+                                    "max_range", "range_noise_stddev", "dropout_probability", "rate_hz", "mount_x",
+                                    "mount_y", "mount_z", "mount_yaw_deg", "rolling_sweep" });
     const std::string preset = get<std::string>(l, "preset", "lidar.", "vlp32");
     sc.lidar = LidarParams::fromPreset(preset);
     LidarParams& p = sc.lidar;
@@ -301,6 +326,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
   }
   if (const YAML::Node g = root["ground_truth"])
   {
+    requireKnownKeys(g, "ground_truth.", { "size_x", "size_y", "resolution", "stop_speed", "include_no_return_rays" });
     GroundTruthParams& p = sc.ground_truth;
     p.size_x = get<double>(g, "size_x", "ground_truth.", p.size_x);
     p.size_y = get<double>(g, "size_y", "ground_truth.", p.size_y);
@@ -310,20 +336,25 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
   }
   if (const YAML::Node s = root["scene"])
   {
+    requireKnownKeys(s, "scene.", { "cell_size", "margin" });
     sc.scene.cell_size = get<double>(s, "cell_size", "scene.", sc.scene.cell_size);
     sc.scene.margin = get<double>(s, "margin", "scene.", sc.scene.margin);
   }
   const YAML::Node ego = root["ego"];
   if (!ego) throw ParameterError("ego", "is required (route, speed, stops)");
+  requireKnownKeys(ego, "ego.", { "route", "speed", "acceleration", "start_time", "corner_radius", "end", "stops" });
   sc.ego.route = toPoints(ego["route"], "ego.route");
   readMotion(ego, "ego.", sc.ego.route, sc.ego.motion);
 
   if (const YAML::Node errors = root["map_errors"])
   {
+    requireKnownKeys(errors, "map_errors.",
+                     { "unmapped_buildings", "absent_buildings", "shift", "rotation_deg", "offset_buildings" });
     if (const YAML::Node u = errors["unmapped_buildings"])
       for (std::size_t i = 0; i < u.size(); ++i)
       {
         const std::string p = "map_errors.unmapped_buildings[" + std::to_string(i) + "].";
+        requireKnownKeys(u[i], p, { "name", "footprint", "height" });
         WorldBuilding b;
         b.footprint.outer = toPoints(u[i]["footprint"], p + "footprint");
         b.height = get<double>(u[i], "height", p, sc.default_building_height);
@@ -337,6 +368,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
       for (std::size_t i = 0; i < o.size(); ++i)
       {
         const std::string p = "map_errors.offset_buildings[" + std::to_string(i) + "].";
+        requireKnownKeys(o[i], p, { "at", "id", "offset" });
         BuildingOffset b;
         if (o[i]["at"]) b.at = toPoint(o[i]["at"], p + "at");
         else if (o[i]["id"]) b.id = get<std::string>(o[i], "id", p, "");
@@ -349,6 +381,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
       for (std::size_t i = 0; i < a.size(); ++i)
       {
         const std::string p = "map_errors.absent_buildings[" + std::to_string(i) + "].";
+        requireKnownKeys(a[i], p, { "at", "id" });
         if (a[i]["at"]) sc.map_errors.absent_at.push_back(toPoint(a[i]["at"], p + "at"));
         else if (a[i]["id"]) sc.map_errors.absent_ids.push_back(get<std::string>(a[i], "id", p, ""));
         else throw ParameterError(p + "at", "an absent building needs 'at: [x, y]' or 'id: ...'");
@@ -359,6 +392,8 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
   {
     LocalisationError& e = sc.localisation_error;
     const std::string p = "localisation_error.";
+    requireKnownKeys(l, p, { "bias", "bias_yaw_deg", "random_walk", "random_walk_time", "white_noise", "reported_sigma",
+                             "covariance_rate_hz" });
     if (l["bias"]) e.bias = toPoint(l["bias"], p + "bias");
     e.bias_yaw_deg = get<double>(l, "bias_yaw_deg", p, e.bias_yaw_deg);
     e.random_walk = get<double>(l, "random_walk", p, e.random_walk);
@@ -372,6 +407,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
   {
     Terrain& e = sc.terrain;
     const std::string p = "terrain.";
+    requireKnownKeys(t, p, { "grade", "grade_length", "camber", "camber_width", "pitch_amplitude_deg", "pitch_period" });
     e.grade = get<double>(t, "grade", p, e.grade);
     e.grade_length = get<double>(t, "grade_length", p, e.grade_length);
     e.camber = get<double>(t, "camber", p, e.camber);
@@ -388,6 +424,8 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
     {
       const YAML::Node n = objects[i];
       const std::string p = "objects[" + std::to_string(i) + "].";
+      requireKnownKeys(n, p, { "id", "kind", "path", "at", "yaw_deg", "length", "width", "height", "radius", "z_min",
+                               "speed", "acceleration", "corner_radius", "start_time", "end", "stops", "class" });
       ObjectSpec o;
       const std::string kind = get<std::string>(n, "kind", p, "car");
       if (!objectKindDefaults(kind, o))

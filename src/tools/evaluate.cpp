@@ -72,6 +72,8 @@ struct Options
   double match_radius = 1.0;   // m: a V cell farther from every moving labelled point is a false V
   bool ablations = true;
   bool quiet = false;
+  bool check_config = false;   ///< only load and validate the configuration files
+  std::set<std::string> only;  ///< run only these variants (empty: all)
 };
 
 void usage()
@@ -80,7 +82,8 @@ void usage()
                "                [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
                "                [--pose-covariance-topic T] (softens the prior by the sigma of T)\n"
                "                [--map FILE] [--origin LAT,LON[,ALT]] [--snapshot-time S] [--sheet-period S]\n"
-               "                [--match-radius M] [--no-ablations] [--quiet]\n"
+               "                [--match-radius M] [--no-ablations] [--only VARIANT[,VARIANT...]] [--quiet]\n"
+               "       evaluate --check-config [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
                "  Runs the pipeline offline on the bag with the configured method (variant `default`), the\n"
                "  paper's exact method (`paper`) and their ablations, scores a bag recorded from the live\n"
                "  nodelets (topic /map_aided_fusion/decision) when given, and writes DIR/metrics.json,\n"
@@ -89,7 +92,8 @@ void usage()
                "  a labelled real bag (/ground_truth/points, from kitti_to_bag) per labelled point: false V (V cells\n"
                "  farther than --match-radius, 1 m, from every moving point), moving objects' cells decided V,\n"
                "  decisions of static obstacle cells. Without --map (or a map_file in the prior config) the\n"
-               "  pipeline runs without prior.\n";
+               "  pipeline runs without prior. --only runs just the named variants (e.g. `default`, as the tuner does).\n"
+               "  --check-config loads and validates the three files and exits: 0, or 1 with the parameter's name.\n";
 }
 
 // ---- configuration files (the nodelets' YAML files, read without a ROS master) -------------------------
@@ -257,6 +261,15 @@ Options parse(int argc, char** argv)
     else if (a == "--match-radius") o.match_radius = argDouble(a, value());
     else if (a == "--pose-covariance-topic") o.pose_covariance_topic = value();
     else if (a == "--no-ablations") o.ablations = false;
+    else if (a == "--check-config") o.check_config = true;
+    else if (a == "--only")
+    {
+      std::stringstream ss(value());
+      std::string name;
+      while (std::getline(ss, name, ','))
+        if (!name.empty()) o.only.insert(name);
+      if (o.only.empty()) throw std::runtime_error("--only needs at least one variant name");
+    }
     else if (a == "--quiet") o.quiet = true;
     else if (a == "-h" || a == "--help")
     {
@@ -266,7 +279,7 @@ Options parse(int argc, char** argv)
     else
       throw std::runtime_error("unknown argument " + a);
   }
-  if (o.bag.empty()) throw std::runtime_error("--bag is required");
+  if (o.bag.empty() && !o.check_config) throw std::runtime_error("--bag is required");
   return o;
 }
 
@@ -354,6 +367,15 @@ int main(int argc, char** argv)
     core::Profile configured;
     configured.map_grid = fusionParams(fusion_cfg);
     configured.scan_grid = scanGridParams(scan_cfg);
+    if (opt.check_config)
+    {
+      map_io::PriorGridParams pp;
+      map_io::forEachPriorGridParam(pp, map_io::yamlReader(prior_cfg));
+      pp.beta.validate();
+      pp.options.validate();
+      std::cout << "configuration valid\n";
+      return 0;
+    }
     std::string prior_summary;
     const std::optional<MapSource> map_source = loadMap(opt, prior_cfg, prior_summary);
     if (map_source) configured.prior = map_source->params.options;
@@ -441,6 +463,7 @@ int main(int argc, char** argv)
     };
     auto add = [&](const std::string& name, const std::string& description, const core::Profile& profile, bool use_prior) {
       if (use_prior && !prior) return;
+      if (!opt.only.empty() && !opt.only.count(name)) return;
       variants.push_back(std::make_unique<Variant>(name, description, profile, use_prior, opt.match_radius));
       if (use_prior) variants.back()->softener.setPrior(priorFor(profile.prior));
     };
@@ -486,6 +509,13 @@ int main(int argc, char** argv)
       }
     }
 
+    if (variants.empty())
+    {
+      std::string names;
+      for (const auto& n : opt.only) names += (names.empty() ? "" : ",") + n;
+      throw std::runtime_error("--only " + names + ": no such variant for this bag (default, paper, ...; the prior "
+                                                   "variants need a map)");
+    }
     fs::create_directories(fs::path(opt.out) / "snapshots");
     std::ofstream csv(fs::path(opt.out) / "scores.csv");
     if (point_mode)

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <string>
+#include <type_traits>
 
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/pignistic.hpp"
@@ -425,4 +427,30 @@ TEST(Objects, ConnectedRegionsWithExtentAndClass)
   EXPECT_NEAR(bus.width, 2.0, 1e-9);
   EXPECT_NEAR(bus.centroid.x, 8.0, 1e-9);
   EXPECT_NEAR(bus.centroid.y, 5.5, 1e-9);
+}
+
+TEST(MapGridParams, CombinationRuleIsAParameterNamedInErrors)
+{
+  for (CombinationRule r : { CombinationRule::kModifiedYager, CombinationRule::kYager, CombinationRule::kDempster })
+    EXPECT_EQ(parseCombinationRule(toString(r)), r);
+  EXPECT_STREQ(toString(MapGridParams{}.fusion.rule), "modified_yager") << "the paper's rule by default";
+  auto withRule = [](const std::string& name) {
+    MapGridParams p;
+    forEachParam(p, [&](const std::string& key, auto& value) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(value)>, std::string>)
+        if (key == "combination_rule") value = name;
+    });
+    return p.fusion.rule;
+  };
+  EXPECT_EQ(withRule("dempster"), CombinationRule::kDempster);
+  EXPECT_EQ(withRule("yager"), CombinationRule::kYager);
+  try
+  {
+    withRule("murphy");
+    FAIL() << "an unknown rule must be refused";
+  }
+  catch (const ParameterError& e)
+  {
+    EXPECT_EQ(e.parameter(), "combination_rule");
+  }
 }

@@ -382,3 +382,30 @@ TEST(SimScenario, ErrorsNameTheKey)
   EXPECT_EQ(keyOf(ego + "map_origin: [91, 0]"), "map_origin");
   EXPECT_EQ(keyOf(ego), "no error");
 }
+
+TEST(SimScenario, UnknownKeysAreErrorsNamingThem)
+{
+  auto keyOf = [](const std::string& text) {
+    try
+    {
+      parseScenario(text, "");
+    }
+    catch (const core::ParameterError& e)
+    {
+      return e.parameter();
+    }
+    return std::string("no error");
+  };
+  const std::string ego = "ego: {route: [[0, 0]], speed: 0}\n";
+  EXPECT_EQ(keyOf(ego + "speeed: 3"), "speeed");
+  EXPECT_EQ(keyOf("ego: {route: [[0, 0]], sped: 2}"), "ego.sped");
+  EXPECT_EQ(keyOf("ego: {route: [[0, 0], [9, 0]], stops: [{at: [1, 0], duraton: 2}]}"), "ego.stops[0].duraton");
+  EXPECT_EQ(keyOf(ego + "lidar: {preset: vlp32, max_rnge: 50}"), "lidar.max_rnge");
+  EXPECT_EQ(keyOf(ego + "objects: [{kind: car, at: [0, 0], colour: red}]"), "objects[0].colour");
+  EXPECT_EQ(keyOf(ego + "map_errors: {shift: [0, 0], rotation: 1}"), "map_errors.rotation");
+  EXPECT_EQ(keyOf(ego + "map_errors: {absent_buildings: [{at: [0, 0], why: gone}]}"), "map_errors.absent_buildings[0].why");
+  EXPECT_EQ(keyOf(ego + "localisation_error: {bais: [0, 0]}"), "localisation_error.bais");
+  EXPECT_EQ(keyOf(ego + "terrain: {grad: 0.01}"), "terrain.grad");
+  EXPECT_EQ(keyOf(ego + "ground_truth: {size: 10}"), "ground_truth.size");
+  EXPECT_EQ(keyOf(ego + "scene: {cells: 1}"), "scene.cells");
+}

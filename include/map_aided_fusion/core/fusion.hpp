@@ -10,6 +10,8 @@
  */
 #pragma once
 
+#include <string>
+
 #include "map_aided_fusion/core/counter.hpp"
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/grid_ops.hpp"
@@ -28,6 +30,11 @@ enum class CombinationRule
   kYager,          ///< all the conflict → Ω
   kDempster,       ///< normalised; total conflict gives the vacuous mass function
 };
+
+/// The rule's name in config/fusion.yaml (`combination_rule`): modified_yager, yager or dempster.
+const char* toString(CombinationRule rule);
+/// @throws ParameterError("combination_rule") for a name other than modified_yager, yager or dempster.
+CombinationRule parseCombinationRule(const std::string& name);
 
 /// Everything one fusion step needs. The defaults are the paper's method; the other options exist for
 /// ablation studies (evaluate's variants).

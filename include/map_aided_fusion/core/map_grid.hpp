@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "map_aided_fusion/core/cell_class.hpp"
@@ -126,6 +127,9 @@ void forEachParam(MapGridParams& p, Get&& get)
   bool literal = p.fusion.counter.mode == SpecialisationMode::kLiteral;
   get("specialise_literal", literal);
   p.fusion.counter.mode = literal ? SpecialisationMode::kLiteral : SpecialisationMode::kMovingToStopped;
+  std::string rule = toString(p.fusion.rule);
+  get("combination_rule", rule);
+  p.fusion.rule = parseCombinationRule(rule);
   get("moving_expiry", p.fusion.moving_expiry);
   get("decision_threshold", p.decision_threshold);
   get("min_object_cells", p.min_object_cells);
