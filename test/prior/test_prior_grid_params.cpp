@@ -215,3 +215,26 @@ TEST(Profiles, IbeoScanGridDiffersFromTheDefaultOnlyWhereTheSensorNeedsIt)
   EXPECT_EQ(ibeo.grid_resolution, 0.5) << "the paper's cells";
   EXPECT_EQ(ibeo.grid_size_x, 100.0) << "the paper's window";
 }
+
+TEST(Profiles, LearnedProfileIsCompleteValidAndKeepsTheIbeoSensorLines)
+{
+  // config/learned/ is written by `learning/tune --report`: every key of config/, validated, and its IBEO ScanGrid
+  // differs from its ScanGrid only where the sensor needs it.
+  const std::string dir = std::string(MAF_PACKAGE_DIR) + "/config/learned/";
+  const core::MapGridParams fusion = loadFile<core::MapGridParams>(dir + "fusion.yaml");
+  EXPECT_NO_THROW(fusion.validate());
+  const core::ScanGridParams scan = loadFile<core::ScanGridParams>(dir + "scan_grid.yaml");
+  const core::ScanGridParams ibeo = loadFile<core::ScanGridParams>(dir + "ibeo/scan_grid.yaml");
+  EXPECT_NO_THROW(scan.validate());
+  EXPECT_NO_THROW(ibeo.validate());
+  const auto a = valuesOf(ibeo), b = valuesOf(scan);
+  std::set<std::string> differ;
+  for (const auto& kv : a)
+    if (b.at(kv.first) != kv.second) differ.insert(kv.first);
+  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "ground_model", "relative_height_limit" }));
+  map_io::PriorGridParams prior;
+  map_io::forEachPriorGridParam(prior, map_io::yamlReader(YAML::LoadFile(dir + "prior_grid.yaml")));
+  EXPECT_NO_THROW(prior.beta.validate());
+  EXPECT_NO_THROW(prior.options.validate());
+  EXPECT_NE(valuesOf(fusion), valuesOf(core::defaultProfile().map_grid)) << "learned values, not a copy of config/";
+}
