@@ -54,14 +54,16 @@ void setCells(benchmark::State& state, int n)
                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+/// Args: N (cells per side), threads.
 void BM_FusionStep(benchmark::State& state)
 {
   const int n = static_cast<int>(state.range(0));
+  const Parallel parallel(static_cast<int>(state.range(1)));
   Scene scene(n);
   FusionParams params;
   for (auto _ : state)
   {
-    fusionStep(scene.map, scene.scan, &scene.prior, params);
+    fusionStep(scene.map, scene.scan, &scene.prior, params, nullptr, nullptr, &parallel);
     benchmark::ClobberMemory();
   }
   setCells(state, n);
@@ -69,10 +71,11 @@ void BM_FusionStep(benchmark::State& state)
 
 /// Reads every plane the fusion step reads (32 mass planes, ζ, 3 scan planes, 3 prior planes) and
 /// writes the 32 mass planes and ζ: the memory traffic of BM_FusionStep with no arithmetic, with the same
-/// blocking and prefetching.
+/// blocking, prefetching, chunks and threads. Args: N, threads.
 void BM_StreamBaseline(benchmark::State& state)
 {
   const int n = static_cast<int>(state.range(0));
+  const Parallel parallel(static_cast<int>(state.range(1)));
   Scene scene(n);
   const std::size_t cells = scene.map.numCells();
   const std::size_t stride = scene.map.stride();
@@ -83,19 +86,21 @@ void BM_StreamBaseline(benchmark::State& state)
     const float* in[6] = { scene.scan.plane(FrameSG::kF), scene.scan.plane(FrameSG::kO),
                            scene.scan.plane(FrameSG::kOmega), scene.prior.building.data(),
                            scene.prior.road.data(), scene.prior.other.data() };
-    for (std::size_t i0 = 0; i0 < cells; i0 += kBlock)
-    {
-      for (int a = 0; a <= 32; ++a) __builtin_prefetch(base + a * stride + i0 + kAhead, 1, 0);
-      const std::size_t len = std::min(kBlock, cells - i0);
-      float add[kBlock] = {};
-      for (const float* p : in)
-        for (std::size_t k = 0; k < len; ++k) add[k] += p[i0 + k];
-      for (int a = 0; a <= 32; ++a)
+    parallel.forRange(cells, kFusionChunkCells, [&](std::size_t c0, std::size_t c1) {
+      for (std::size_t i0 = c0; i0 < c1; i0 += kBlock)
       {
-        float* plane = base + a * stride + i0;
-        for (std::size_t k = 0; k < len; ++k) plane[k] = plane[k] * 0.5f + add[k];
+        for (int a = 0; a <= 32; ++a) __builtin_prefetch(base + a * stride + i0 + kAhead, 1, 0);
+        const std::size_t len = std::min(kBlock, c1 - i0);
+        float add[kBlock] = {};
+        for (const float* p : in)
+          for (std::size_t k = 0; k < len; ++k) add[k] += p[i0 + k];
+        for (int a = 0; a <= 32; ++a)
+        {
+          float* plane = base + a * stride + i0;
+          for (std::size_t k = 0; k < len; ++k) plane[k] = plane[k] * 0.5f + add[k];
+        }
       }
-    }
+    });
     benchmark::ClobberMemory();
   }
   setCells(state, n);
@@ -187,8 +192,10 @@ void BM_PignisticGrid(benchmark::State& state)
 
 }  // namespace
 
-BENCHMARK(BM_FusionStep)->Arg(200)->Arg(800)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_StreamBaseline)->Arg(200)->Arg(800)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FusionStep)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StreamBaseline)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RefineGrid)->Arg(800)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CombineWithPriorGrid)->Arg(800)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ContextualDiscountGrid)->Arg(800)->Unit(benchmark::kMillisecond);

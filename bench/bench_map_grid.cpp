@@ -10,11 +10,13 @@ using namespace map_aided_fusion::core;
 
 namespace {
 
+/// Args: N (cells per side), threads (MapGridParams::threads).
 void BM_MapGridUpdate(benchmark::State& state)
 {
   const int n = static_cast<int>(state.range(0));
   const double res = n == 200 ? 0.5 : 0.2;
   MapGridParams params;
+  params.threads = static_cast<int>(state.range(1));
   params.size_x = params.size_y = n * res;
   params.resolution = res;
   MapGrid grid(params);
@@ -38,7 +40,7 @@ void BM_MapGridUpdate(benchmark::State& state)
     pose.x += 1.0;  // 10 m/s at 10 Hz: the window shifts every scan
     pose.yaw += 0.01;
     grid.update(scan, pose, t += 0.1, &prior);
-    decide(grid.masses(), grid.pignistic(), params.decision_threshold, decision);
+    decide(grid.masses(), grid.pignistic(), params.decision_threshold, decision, &grid.parallel());
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n) * n);
@@ -46,4 +48,5 @@ void BM_MapGridUpdate(benchmark::State& state)
 
 }  // namespace
 
-BENCHMARK(BM_MapGridUpdate)->Arg(200)->Arg(800)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MapGridUpdate)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()
+    ->Unit(benchmark::kMillisecond);

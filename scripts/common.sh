@@ -24,7 +24,7 @@ MAF_DEB_PACKAGES=(
   libeigen3-dev libgeographiclib-dev libgdal-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev
   libpcl-dev libpcl-ros-dev libpcl-ros-filters0d libpcl-ros-filter1d tf2-tools
-  python3-yaml python3-optuna python3-psycopg2 python3-pytest postgresql
+  libtbb-dev python3-yaml python3-optuna python3-psycopg2 python3-pytest postgresql
 )
 
 maf_log() { printf '\033[1m[map_aided_fusion]\033[0m %s\n' "$*" >&2; }

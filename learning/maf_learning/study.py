@@ -181,7 +181,9 @@ def _objective(setup, reference):
         trial.set_user_attr("worker", f"{host}:{pid}")
         values = {p.key: p.suggest(trial) for p in params}
         config_dir = os.path.join(setup.work, "trials", f"{trial.number:05d}")
-        sp.write_config_dir(config_dir, sp.split_values(values), setup.config)
+        by_file = sp.split_values(values)
+        by_file.setdefault("fusion.yaml", {}).setdefault("threads", 1)  # one worker per core already
+        sp.write_config_dir(config_dir, by_file, setup.config)
         metrics = []
         try:
             for k, d in enumerate(setup.training):

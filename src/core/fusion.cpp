@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <vector>
 
 #include "cell_kernels.hpp"
 
@@ -85,6 +86,27 @@ struct StepInputs
   bool use_counter;
   bool moving_expiry;
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
+
+  /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved, the plane stride kept.
+  StepInputs offset(std::size_t begin, std::size_t count) const
+  {
+    StepInputs o = *this;
+    auto move = [begin](auto*& p) {
+      if (p) p += begin;
+    };
+    move(o.base);
+    move(o.zeta);
+    move(o.sf);
+    move(o.so);
+    move(o.sw);
+    move(o.pb);
+    move(o.pr);
+    move(o.pt);
+    move(o.pw);
+    for (auto*& b : o.betp) move(b);
+    o.cells = count;
+    return o;
+  }
 };
 
 /// kPaper: the paper's method (⊛, contextual discounting, counter) compiled without the ablation branches,
@@ -147,7 +169,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
 
 MAF_TARGET_CLONES
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
-                FusionStepStats* stats, PignisticPlanes* betp)
+                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel)
 {
   params.validate();
   if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
@@ -184,15 +206,35 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
     if (betp) betp->p[e].resize(in.cells);
     in.betp[e] = betp ? betp->p[e].data() : nullptr;
   }
-  FusionStepStats local;
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
-  if (prior && prior->hasWall())
-    paper ? fusionLoop<true, true, true>(in, w, local) : fusionLoop<true, false, true>(in, w, local);
-  else if (prior)
-    paper ? fusionLoop<true, true, false>(in, w, local) : fusionLoop<true, false, false>(in, w, local);
+  auto run = [&](const StepInputs& part, FusionStepStats& out) {
+    if (prior && prior->hasWall())
+      paper ? fusionLoop<true, true, true>(part, w, out) : fusionLoop<true, false, true>(part, w, out);
+    else if (prior)
+      paper ? fusionLoop<true, true, false>(part, w, out) : fusionLoop<true, false, false>(part, w, out);
+    else
+      paper ? fusionLoop<false, true, false>(part, w, out) : fusionLoop<false, false, false>(part, w, out);
+  };
+  // Fixed chunks (independent of the thread count), their statistics summed in chunk order: bit-identical results.
+  const std::size_t chunks = chunkCount(in.cells, kFusionChunkCells);
+  std::vector<FusionStepStats> partial(chunks);
+  auto chunk = [&](std::size_t c) {
+    const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
+    run(in.offset(begin, end - begin), partial[c]);
+  };
+  if (parallel)
+    parallel->forChunks(chunks, chunk);
   else
-    paper ? fusionLoop<false, true, false>(in, w, local) : fusionLoop<false, false, false>(in, w, local);
-  if (stats) *stats = local;
+    for (std::size_t c = 0; c < chunks; ++c) chunk(c);
+  FusionStepStats total;
+  for (const FusionStepStats& p : partial)
+  {
+    total.sum_conflict_free_occupied += p.sum_conflict_free_occupied;
+    total.sum_conflict_occupied_free += p.sum_conflict_occupied_free;
+    total.sum_conflict_other += p.sum_conflict_other;
+    total.num_cells += p.num_cells;
+  }
+  if (stats) *stats = total;
 }
 
 }  // namespace core

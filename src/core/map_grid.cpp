@@ -19,6 +19,10 @@ namespace {
 constexpr int kMaxWindowCells = 8192;
 /// Side of the square tiles projectScan() walks the window in, cells.
 constexpr int kProjectTile = 32;
+constexpr std::size_t kClearanceRows = 64;     // rows per chunk of the clearance's row pass
+constexpr std::size_t kClearanceColumns = 256;  // columns per chunk of its column pass
+constexpr std::size_t kCellChunk = 16384;      // cells per chunk of the per-cell passes
+constexpr std::size_t kPriorRows = 32;         // rows per chunk of the prior window's copy
 /// Bounds of memory_budget_mb, MiB.
 constexpr double kMinBudgetMb = 1.0;
 constexpr double kMaxBudgetMb = 1048576.0;
@@ -75,6 +79,7 @@ void MapGridParams::validate() const
   requireUnit("motion_margin", motion_margin);
   requireUnit("map_conflict_gain", map_conflict_gain);
   requireInRange("position_sigma", position_sigma, 0.0, kMaxPositionSigma);
+  validateThreads("threads", threads);
   if (motion_max_cells < 1) throw ParameterError("motion_max_cells", "must be at least 1");
   if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
   fusion.validate();
@@ -101,8 +106,10 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
 }
 
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out,
-                 const ObstaclePoints* obstacles, int clearance_cells)
+                 const ObstaclePoints* obstacles, int clearance_cells, const Parallel* parallel)
 {
+  const Parallel serial(1);
+  const Parallel& par = parallel ? *parallel : serial;
   if (out.geometry() != window) out.reset(window);
   const GridGeometry& sg = scan.geometry();
   // m(∅) of a ScanGrid is not used by the fusion: only F, O and Ω are mapped (∅ stays 0 in out).
@@ -123,7 +130,9 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
   const double fx00 = (c * dx0 + s * dy0 - sg.origin_x) * inv_res, fy00 = (-s * dx0 + c * dy0 - sg.origin_y) * inv_res;
   const double drx = s * window.resolution * inv_res, dry = c * window.resolution * inv_res;  // per window row
   const double sw_max = sg.width, sh_max = sg.height;
-  for (int ty = 0; ty < h; ty += kProjectTile)
+  // One band of kProjectTile rows per chunk: each writes its own rows.
+  par.forChunks(chunkCount(static_cast<std::size_t>(h), kProjectTile), [&](std::size_t band) {
+    const int ty = static_cast<int>(band) * kProjectTile;
     for (int tx = 0; tx < w; tx += kProjectTile)
       for (int y = ty; y < std::min(h, ty + kProjectTile); ++y)
       {
@@ -147,6 +156,7 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
           }
         }
       }
+  });
   if (points)
   {
     // Point occupancy: each return marks the window cell under it with its scan cell's occupied mass.
@@ -182,48 +192,57 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
   }
   if (clearance_cells <= 0) return;
   // Obstacle clearance: no free evidence within clearance_cells (square) of an occupied cell; a separable running
-  // count (along rows, then down the columns, row by row), linear in the window whatever the number of occupied cells.
+  // count (along each row, then down each strip of columns), linear in the window whatever the number of occupied
+  // cells. Rows, then column strips, are independent chunks.
   thread_local std::vector<std::uint8_t> rows;
-  thread_local std::vector<int> column;
   const std::size_t n = window.numCells();
   const std::size_t ws = static_cast<std::size_t>(w);
   if (rows.size() < n) rows.resize(n);
-  column.assign(ws, 0);
+  std::uint8_t* const near = rows.data();
   const int k = clearance_cells;
-  for (int y = 0; y < h; ++y)
-  {
-    const std::size_t r = static_cast<std::size_t>(y) * ws;
-    int count = 0;
-    for (int x = 0; x < std::min(w, k); ++x) count += d_o[r + x] > 0.0f;
-    for (int x = 0; x < w; ++x)
+  par.forRange(static_cast<std::size_t>(h), kClearanceRows, [&](std::size_t y0, std::size_t y1) {
+    for (std::size_t y = y0; y < y1; ++y)
     {
-      if (x + k < w) count += d_o[r + x + k] > 0.0f;
-      if (x - k - 1 >= 0) count -= d_o[r + x - k - 1] > 0.0f;
-      rows[r + x] = count > 0;
-    }
-  }
-  for (int y = 0; y < std::min(h, k); ++y)
-    for (std::size_t x = 0; x < ws; ++x) column[x] += rows[static_cast<std::size_t>(y) * ws + x];
-  for (int y = 0; y < h; ++y)
-  {
-    const std::uint8_t* add = y + k < h ? rows.data() + static_cast<std::size_t>(y + k) * ws : nullptr;
-    const std::uint8_t* sub = y - k - 1 >= 0 ? rows.data() + static_cast<std::size_t>(y - k - 1) * ws : nullptr;
-    float* f = df + static_cast<std::size_t>(y) * ws;
-    float* u = dw + static_cast<std::size_t>(y) * ws;
-    for (std::size_t x = 0; x < ws; ++x)
-    {
-      column[x] += (add ? add[x] : 0) - (sub ? sub[x] : 0);
-      if (column[x] > 0)
+      const std::size_t r = y * ws;
+      int count = 0;
+      for (int x = 0; x < std::min(w, k); ++x) count += d_o[r + x] > 0.0f;
+      for (int x = 0; x < w; ++x)
       {
-        u[x] += f[x];
-        f[x] = 0.0f;
+        if (x + k < w) count += d_o[r + x + k] > 0.0f;
+        if (x - k - 1 >= 0) count -= d_o[r + x - k - 1] > 0.0f;
+        near[r + x] = count > 0;
       }
     }
-  }
+  });
+  par.forRange(ws, kClearanceColumns, [&](std::size_t x0, std::size_t x1) {
+    int column[kClearanceColumns] = {};
+    const std::size_t cw = x1 - x0;
+    for (int y = 0; y < std::min(h, k); ++y)
+      for (std::size_t x = 0; x < cw; ++x) column[x] += near[static_cast<std::size_t>(y) * ws + x0 + x];
+    for (int y = 0; y < h; ++y)
+    {
+      const std::uint8_t* add = y + k < h ? near + static_cast<std::size_t>(y + k) * ws + x0 : nullptr;
+      const std::uint8_t* sub = y - k - 1 >= 0 ? near + static_cast<std::size_t>(y - k - 1) * ws + x0 : nullptr;
+      float* f = df + static_cast<std::size_t>(y) * ws + x0;
+      float* u = dw + static_cast<std::size_t>(y) * ws + x0;
+      for (std::size_t x = 0; x < cw; ++x)
+      {
+        column[x] += (add ? add[x] : 0) - (sub ? sub[x] : 0);
+        if (column[x] > 0)
+        {
+          u[x] += f[x];
+          f[x] = 0.0f;
+        }
+      }
+    }
+  });
 }
 
-void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out)
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
+                        const Parallel* parallel)
 {
+  const Parallel serial(1);
+  const Parallel& par = parallel ? *parallel : serial;
   if (out.building.size() != window.numCells() || out.wall.size() != window.numCells())
     out.reset(window);
   out.geometry = window;
@@ -234,7 +253,8 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
     const double fx = std::floor((wx - prior.geometry.origin_x) / prior.geometry.resolution);
     column[static_cast<std::size_t>(x)] = fx >= 0 && fx < prior.geometry.width ? static_cast<int>(fx) : -1;
   }
-  for (int y = 0; y < window.height; ++y)
+  par.forRange(static_cast<std::size_t>(window.height), kPriorRows, [&](std::size_t y0, std::size_t y1) {
+  for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
   {
     const double wy = window.cellCentre(CellIndex{ 0, y }).y;
     const double fy = std::floor((wy - prior.geometry.origin_y) / prior.geometry.resolution);
@@ -255,16 +275,22 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
       out.wall[j] = prior.wall[i];
     }
   }
+  });
 }
 
-void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out)
+void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out,
+            const Parallel* parallel)
 {
   const std::size_t n = grid.numCells();
   out.resize(n);
+  const Parallel serial(1);
+  const Parallel& par = parallel ? *parallel : serial;
   const float* omega = grid.plane(FrameMG::kOmega);
   const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
   const float t = static_cast<float>(threshold);
-  for (std::size_t i = 0; i < n; ++i)
+  std::int8_t* const d = out.data();
+  par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
+  for (std::size_t i = i0; i < i1; ++i)
   {
     float best_p = p[0][i];
     std::int8_t best = 0;
@@ -275,14 +301,15 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
       best = better ? static_cast<std::int8_t>(e) : best;
     }
     const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
-    out[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
+    d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
   }
+  });
 }
 
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
-            std::vector<std::int8_t>& out)
+            std::vector<std::int8_t>& out, const Parallel* parallel)
 {
-  decide(grid, betp, params.decision_threshold, out);
+  decide(grid, betp, params.decision_threshold, out, parallel);
   if (params.motion_margin <= 0.0) return;
   const float margin = static_cast<float>(params.motion_margin);
   const float* ps = betp[FrameMG::kSize - 2].data();
@@ -292,12 +319,16 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
   const float* omega = grid.plane(FrameMG::kOmega);
   const float t = static_cast<float>(params.decision_threshold);
   const auto unknown = static_cast<std::int8_t>(CellClass::kUnknown);
-  for (std::size_t i = 0; i < out.size(); ++i)
-  {
-    const bool tie = (out[i] == stopped || out[i] == moving) && std::abs(ps[i] - pv[i]) < margin;
-    const bool unclassified = out[i] == unknown && omega[i] < 1.0f - kVacuousTolerance && 1.0f - pf[i] >= t;
-    if (tie || unclassified) out[i] = static_cast<std::int8_t>(CellClass::kOccupied);
-  }
+  std::int8_t* const d = out.data();
+  const Parallel serial(1);
+  (parallel ? *parallel : serial).forRange(out.size(), kCellChunk, [&](std::size_t i0, std::size_t i1) {
+    for (std::size_t i = i0; i < i1; ++i)
+    {
+      const bool tie = (d[i] == stopped || d[i] == moving) && std::abs(ps[i] - pv[i]) < margin;
+      const bool unclassified = d[i] == unknown && omega[i] < 1.0f - kVacuousTolerance && 1.0f - pf[i] >= t;
+      if (tie || unclassified) d[i] = static_cast<std::int8_t>(CellClass::kOccupied);
+    }
+  });
 }
 
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
@@ -454,6 +485,8 @@ void MapGrid::setParams(const MapGridParams& params)
   const GridGeometry g = GridGeometry::centred(params.size_x, params.size_y, params.resolution);
   const bool realloc =
       grid_.geometry().width != g.width || grid_.geometry().height != g.height || grid_.geometry().resolution != g.resolution;
+  if (!parallel_ || parallel_->threads() != resolveThreads(params.threads))
+    parallel_ = std::make_shared<const Parallel>(params.threads);
   params_ = params;
   if (realloc)
   {
@@ -512,12 +545,15 @@ void MapGrid::shift(int dx, int dy)
     std::fill(map_doubt_.begin(), map_doubt_.end(), 0.0f);
     return;
   }
-  for (int plane = 0; plane <= FrameMG::kNumSubsets; ++plane)
-  {
-    float* p = plane == FrameMG::kNumSubsets ? grid_.counter() : grid_.plane(static_cast<Subset>(plane));
+  // Every plane (the masses, ζ and the map doubt) is its own chunk.
+  const bool doubt = map_doubt_.size() == g.numCells();
+  parallel_->forChunks(FrameMG::kNumSubsets + 1 + (doubt ? 1 : 0), [&](std::size_t c) {
+    const int plane = static_cast<int>(c);
+    float* p = plane == FrameMG::kNumSubsets + 1 ? map_doubt_.data()
+               : plane == FrameMG::kNumSubsets   ? grid_.counter()
+                                                 : grid_.plane(static_cast<Subset>(plane));
     shiftPlane(p, g, dx, dy, plane == FrameMG::kOmega ? 1.0f : 0.0f);
-  }
-  if (map_doubt_.size() == g.numCells()) shiftPlane(map_doubt_.data(), g, dx, dy, 0.0f);
+  });
 }
 
 void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow& prior, std::vector<std::int8_t>& out)
@@ -538,25 +574,31 @@ void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow&
   }
 }
 
-void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt)
+void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt,
+                      const Parallel* parallel)
 {
+  const Parallel serial(1);
+  const Parallel& par = parallel ? *parallel : serial;
   const std::size_t n = prior.geometry.numCells();
   if (doubt.size() != n) doubt.assign(n, 0.0f);
   const float g = static_cast<float>(gain);
   const float* sf = scan.plane(FrameSG::kF);
   const float* so = scan.plane(FrameSG::kO);
-  for (std::size_t i = 0; i < n; ++i)
+  float* const eta_out = doubt.data();
+  par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
+  for (std::size_t i = i0; i < i1; ++i)
   {
     const float k = prior.building[i] * sf[i];
     const float a = (prior.building[i] + prior.wall[i]) * so[i];
-    const float eta = std::clamp(doubt[i] + g * (k - a), 0.0f, 1.0f);
-    doubt[i] = eta;
+    const float eta = std::clamp(eta_out[i] + g * (k - a), 0.0f, 1.0f);
+    eta_out[i] = eta;
     const float keep = 1.0f - eta;
     prior.building[i] *= keep;
     prior.road[i] *= keep;
     prior.other[i] *= keep;
     prior.wall[i] *= keep;
   }
+  });
 }
 
 void MapGrid::recentre(Point2 p)
@@ -590,14 +632,16 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
 
   t0 = std::chrono::steady_clock::now();
   const int clearance = static_cast<int>(std::lround(params_.obstacle_clearance / params_.resolution));
-  projectScan(scan, pose, grid_.geometry(), scan_window_, params_.point_occupancy ? obstacles : nullptr, clearance);
+  projectScan(scan, pose, grid_.geometry(), scan_window_, params_.point_occupancy ? obstacles : nullptr, clearance,
+              parallel_.get());
   t.project_scan = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
   if (prior)
   {
-    extractPriorWindow(*prior, grid_.geometry(), prior_window_);
-    if (params_.map_conflict_gain > 0.0) applyMapConflict(prior_window_, scan_window_, params_.map_conflict_gain, map_doubt_);
+    extractPriorWindow(*prior, grid_.geometry(), prior_window_, parallel_.get());
+    if (params_.map_conflict_gain > 0.0)
+      applyMapConflict(prior_window_, scan_window_, params_.map_conflict_gain, map_doubt_, parallel_.get());
   }
   t.prior_window = secondsSince(t0);
 
@@ -605,7 +649,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   FusionParams fp = params_.fusion;
   if (params_.rates_per_second && scans_ > 0) fp.discount = fp.discount.compounded(std::max(0.0, stamp - last_stamp_));
   FusionStepStats stats;
-  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_);
+  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_, parallel_.get());
   spreadMotion(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells, params_.decision_threshold,
                params_.motion_margin);
   t.fusion = secondsSince(t0);

@@ -498,7 +498,7 @@ void FusionWorker::publish(const std_msgs::Header& header)
     betp_pub_[e].publish(occ);
   }
   std::vector<std::int8_t> decision;
-  core::decide(grid, betp, grid_.params(), decision);
+  core::decide(grid, betp, grid_.params(), decision, &grid_.parallel());
   const auto publishLayer = [&](ros::Publisher& pub, const std::vector<std::int8_t>& data) {
     auto occ = boost::make_shared<nav_msgs::OccupancyGrid>();
     occ->header = header;

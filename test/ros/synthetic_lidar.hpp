@@ -42,14 +42,22 @@ inline bool rayHitsBox(double x, double y, const Box& b)
   return true;
 }
 
+/// The ground rings of a synthetic sweep: every range_step from 2 m to max_range, azimuths per ring.
+struct Rings
+{
+  double max_range = 30.0;  ///< m
+  double range_step = 0.5;  ///< m
+  int azimuths = 720;       ///< per ring (0.5 deg)
+};
+
 /// A cloud in the lidar frame (lidar 1.8 m above base_link): ground rings and the faces of the boxes
 /// (all coordinates given in base_link).
 inline sensor_msgs::PointCloud2 makeCloud(const std::vector<Box>& boxes, const ros::Time& stamp,
-                                          const std::string& frame = "lidar")
+                                          const std::string& frame = "lidar", const Rings& rings = Rings{})
 {
   std::vector<float> xyz;
-  for (double r = 2.0; r < 30.0; r += 0.5)
-    for (double a = -M_PI; a < M_PI; a += M_PI / 360.0)
+  for (double r = 2.0; r < rings.max_range; r += rings.range_step)
+    for (double a = -M_PI; a < M_PI; a += 2.0 * M_PI / rings.azimuths)
     {
       const double x = r * std::cos(a), y = r * std::sin(a);
       bool hidden = false;

@@ -16,6 +16,7 @@
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/grid_ops.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
+#include "map_aided_fusion/core/parallel.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior.hpp"
 #include "map_aided_fusion/core/rules.hpp"
@@ -96,10 +97,15 @@ struct FusionStepStats
  * @param scan   the ScanGrid already in @p map's cells (same geometry).
  * @param prior  the prior window of the same geometry, or nullptr for a vacuous prior.
  * @param betp   when not null, receives BetP of m'_MG,t (computed in the same pass).
+ * @param parallel  when not null, the threads the cells are shared among (chunks of kFusionChunkCells); the masses,
+ *                  BetP and statistics are bit-identical for any number of threads.
  * @throws std::invalid_argument when the geometries differ.
  */
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
-                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr);
+                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr, const Parallel* parallel = nullptr);
+
+/// Cells per chunk of a parallel fusion step (a multiple of the 8-cell vectors and of the prefetch blocks).
+constexpr std::size_t kFusionChunkCells = 16384;
 
 }  // namespace core
 }  // namespace map_aided_fusion

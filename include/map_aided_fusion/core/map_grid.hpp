@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,11 @@ struct MapGridParams
    * pose covariance is configured or received; a received covariance replaces it. 0: the prior as published.
    */
   double position_sigma = 0.0;
+  /**
+   * Threads of the per-scan update (shift, scan projection, prior window, fusion step with BetP, decisions), in
+   * [0, kMaxThreads]; 0: every core. The results are bit-identical for any value (parallel.hpp).
+   */
+  int threads = 0;
   /// Bytes one window cell needs in the MapGrid and its per-scan buffers.
   static std::size_t bytesPerCell();
   /// Bytes the window of these parameters needs (cells × bytesPerCell()).
@@ -141,6 +147,7 @@ void forEachParam(MapGridParams& p, Get&& get)
   get("obstacle_clearance", p.obstacle_clearance);
   get("map_conflict_gain", p.map_conflict_gain);
   get("position_sigma", p.position_sigma);
+  get("threads", p.threads);
 }
 
 /// Wall time of each stage of MapGrid::update(), seconds.
@@ -184,13 +191,14 @@ void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const Gr
  *                   lose their free mass to Ω; 0: none.
  */
 void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const GridGeometry& window, ScanMassGrid& out,
-                 const ObstaclePoints* obstacles, int clearance_cells);
+                 const ObstaclePoints* obstacles, int clearance_cells, const Parallel* parallel = nullptr);
 
 /**
  * @brief The prior masses of @p window, sampled at each window cell's centre from @p prior (nearest
  *        neighbour; an exact copy when the lattices are aligned). Cells outside @p prior are vacuous.
  */
-void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out);
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
+                        const Parallel* parallel = nullptr);
 
 /**
  * @brief The navigable-space layer (nav_msgs/OccupancyGrid values) from a decision grid and the prior of the same
@@ -207,13 +215,15 @@ constexpr std::int8_t kNavigableOffRoad = 50;
  * @brief Step map_conflict (MapGridParams::map_conflict_gain): updates the doubt η of each cell from the scan
  *        @p scan (same geometry) and discounts @p prior by it in place. @p doubt is resized (zeros) when needed.
  */
-void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt);
+void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt,
+                      const Parallel* parallel = nullptr);
 
 /**
  * @brief Decision per cell: the class of largest BetP when it reaches @p threshold, kUnknown otherwise or
  *        where the cell is vacuous (m(Ω) ≥ 1 − 1e-3).
  */
-void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out);
+void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out,
+            const Parallel* parallel = nullptr);
 
 /**
  * @brief The step "motion spreading" on @p grid and its BetP @p betp (both updated in place): see
@@ -228,7 +238,7 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
 /// (S or V decisions within motion_margin of each other, and occupied cells no class decides, become
 /// CellClass::kOccupied).
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
-            std::vector<std::int8_t>& out);
+            std::vector<std::int8_t>& out, const Parallel* parallel = nullptr);
 
 /// Connected regions (8-connectivity) of kMoving or kStopped decisions with at least @p min_cells cells.
 std::vector<GridObject> extractObjects(const GridGeometry& geometry, const std::vector<std::int8_t>& decision,
@@ -287,6 +297,8 @@ public:
   const AlignedVector<float>& mapDoubt() const { return map_doubt_; }
   /// The prior window of the last update, after the map doubt (vacuous without a prior).
   const PriorWindow& priorWindow() const { return prior_window_; }
+  /// The threads of this grid's update (MapGridParams::threads), for the decisions of the same cells.
+  const Parallel& parallel() const { return *parallel_; }
 
 private:
   MapGridParams params_;
@@ -295,6 +307,7 @@ private:
   PriorWindow prior_window_;
   AlignedVector<float> map_doubt_;
   PignisticPlanes betp_;
+  std::shared_ptr<const Parallel> parallel_;
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;
 };
