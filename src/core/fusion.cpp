@@ -165,9 +165,21 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
   stats.num_cells = in.cells;
 }
 
+/// One chunk of the step, compiled for each target of MAF_TARGET_CLONES (a lambda would get only the default one).
+MAF_TARGET_CLONES
+void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w, bool has_prior, bool wall, bool paper,
+                 FusionStepStats& out)
+{
+  if (has_prior && wall)
+    paper ? fusionLoop<true, true, true>(in, w, out) : fusionLoop<true, false, true>(in, w, out);
+  else if (has_prior)
+    paper ? fusionLoop<true, true, false>(in, w, out) : fusionLoop<true, false, false>(in, w, out);
+  else
+    paper ? fusionLoop<false, true, false>(in, w, out) : fusionLoop<false, false, false>(in, w, out);
+}
+
 }  // namespace
 
-MAF_TARGET_CLONES
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
                 FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel)
 {
@@ -207,20 +219,13 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
     in.betp[e] = betp ? betp->p[e].data() : nullptr;
   }
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
-  auto run = [&](const StepInputs& part, FusionStepStats& out) {
-    if (prior && prior->hasWall())
-      paper ? fusionLoop<true, true, true>(part, w, out) : fusionLoop<true, false, true>(part, w, out);
-    else if (prior)
-      paper ? fusionLoop<true, true, false>(part, w, out) : fusionLoop<true, false, false>(part, w, out);
-    else
-      paper ? fusionLoop<false, true, false>(part, w, out) : fusionLoop<false, false, false>(part, w, out);
-  };
+  const bool has_prior = prior != nullptr, wall = prior && prior->hasWall();
   // Fixed chunks (independent of the thread count), their statistics summed in chunk order: bit-identical results.
   const std::size_t chunks = chunkCount(in.cells, kFusionChunkCells);
   std::vector<FusionStepStats> partial(chunks);
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
-    run(in.offset(begin, end - begin), partial[c]);
+    fusionChunk(in.offset(begin, end - begin), w, has_prior, wall, paper, partial[c]);
   };
   if (parallel)
     parallel->forChunks(chunks, chunk);

@@ -247,34 +247,48 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
     out.reset(window);
   out.geometry = window;
   std::vector<int> column(static_cast<std::size_t>(window.width));
+  int first = -1, last = -1;  // window columns inside the prior
+  bool contiguous = true;     // ... mapped to consecutive prior columns (aligned lattices): rows copy as blocks
   for (int x = 0; x < window.width; ++x)
   {
     const double wx = window.cellCentre(CellIndex{ x, 0 }).x;
     const double fx = std::floor((wx - prior.geometry.origin_x) / prior.geometry.resolution);
-    column[static_cast<std::size_t>(x)] = fx >= 0 && fx < prior.geometry.width ? static_cast<int>(fx) : -1;
+    const int px = fx >= 0 && fx < prior.geometry.width ? static_cast<int>(fx) : -1;
+    column[static_cast<std::size_t>(x)] = px;
+    if (px < 0) continue;
+    if (first < 0) first = x;
+    contiguous = contiguous && (last < 0 || (last == x - 1 && px == column[static_cast<std::size_t>(last)] + 1));
+    last = x;
   }
+  const std::size_t ww = static_cast<std::size_t>(window.width);
+  float* const dst[4] = { out.building.data(), out.road.data(), out.other.data(), out.wall.data() };
+  const float* const src[4] = { prior.building.data(), prior.road.data(), prior.other.data(), prior.wall.data() };
   par.forRange(static_cast<std::size_t>(window.height), kPriorRows, [&](std::size_t y0, std::size_t y1) {
-  for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
-  {
-    const double wy = window.cellCentre(CellIndex{ 0, y }).y;
-    const double fy = std::floor((wy - prior.geometry.origin_y) / prior.geometry.resolution);
-    const bool row_inside = fy >= 0 && fy < prior.geometry.height;
-    for (int x = 0; x < window.width; ++x)
+    for (std::size_t y = y0; y < y1; ++y)
     {
-      const std::size_t j = window.index(x, y);
-      const int px = column[static_cast<std::size_t>(x)];
-      if (!row_inside || px < 0)
+      const double wy = window.cellCentre(CellIndex{ 0, static_cast<int>(y) }).y;
+      const double fy = std::floor((wy - prior.geometry.origin_y) / prior.geometry.resolution);
+      const bool row_inside = fy >= 0 && fy < prior.geometry.height && first >= 0;
+      const std::size_t row = y * ww;
+      for (int k = 0; k < 4; ++k)
       {
-        out.building[j] = out.road[j] = out.other[j] = out.wall[j] = 0.0f;
-        continue;
+        float* d = dst[k] + row;
+        if (!row_inside)
+        {
+          std::fill(d, d + ww, 0.0f);
+          continue;
+        }
+        const float* s = src[k] + prior.geometry.index(0, static_cast<int>(fy));
+        if (contiguous)
+        {
+          std::fill(d, d + first, 0.0f);
+          std::copy(s + column[static_cast<std::size_t>(first)], s + column[static_cast<std::size_t>(last)] + 1, d + first);
+          std::fill(d + last + 1, d + ww, 0.0f);
+          continue;
+        }
+        for (std::size_t x = 0; x < ww; ++x) d[x] = column[x] < 0 ? 0.0f : s[column[x]];
       }
-      const std::size_t i = prior.geometry.index(px, static_cast<int>(fy));
-      out.building[j] = prior.building[i];
-      out.road[j] = prior.road[i];
-      out.other[j] = prior.other[i];
-      out.wall[j] = prior.wall[i];
     }
-  }
   });
 }
 

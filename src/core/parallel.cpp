@@ -22,9 +22,10 @@ struct Parallel::Arena
 
 int resolveThreads(int threads)
 {
-  if (threads > 0) return std::min(threads, kMaxThreads);
-  const unsigned cores = std::thread::hardware_concurrency();
-  return std::clamp(static_cast<int>(cores == 0 ? 1 : cores), 1, kMaxThreads);
+  const unsigned hw = std::thread::hardware_concurrency();
+  const int cores = std::clamp(static_cast<int>(hw == 0 ? 1 : hw), 1, kMaxThreads);
+  // More threads than cores only adds switching (and TBB would refuse the extra workers).
+  return threads > 0 ? std::min(threads, cores) : cores;
 }
 
 void validateThreads(const char* name, int threads)

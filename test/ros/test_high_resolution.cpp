@@ -52,8 +52,8 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   ASSERT_GT(points.getNumSubscribers(), 0u) << "nobody subscribes to points";
   ros::WallDuration(3.0).sleep();  // the 0.2 m prior of the town rasterised and latched
 
-  // ~130k points: rings every 0.45 m from 2 m to 80 m, 0.2 deg apart, and a car ahead.
-  const maf_test::Rings rings{ 80.0, 0.45, 1800 };
+  // ~130k points: rings every 0.6 m from 2 m to 80 m, 0.36 deg apart, and a car ahead.
+  const maf_test::Rings rings{ 80.0, 0.6, 1000 };
   const std::vector<maf_test::Box> boxes{ { 12.0, 2.0, 16.5, 4.0, 1.5 } };
   const sensor_msgs::PointCloud2 shape = maf_test::makeCloud(boxes, ros::Time::now(), "lidar", rings);
   const std::size_t per_cloud = shape.width * shape.height;

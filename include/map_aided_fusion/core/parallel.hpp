@@ -24,7 +24,7 @@ namespace core {
 /// Largest `threads` a component accepts.
 constexpr int kMaxThreads = 256;
 
-/// Threads for a `threads` parameter: 0 means every core of the machine; otherwise the value itself.
+/// Threads for a `threads` parameter: 0 means every core of the machine; otherwise the value, at most the cores.
 int resolveThreads(int threads);
 
 /// @throws ParameterError(name) unless 0 ≤ threads ≤ kMaxThreads.
@@ -38,7 +38,7 @@ void validateThreads(const char* name, int threads);
 class Parallel
 {
 public:
-  /// @param threads 0: every core; ≥ 1: at most that many threads (the caller included).
+  /// @param threads 0: every core; ≥ 1: that many threads (the caller included), at most the cores.
   explicit Parallel(int threads = 1);
   ~Parallel();
   Parallel(const Parallel&) = delete;
