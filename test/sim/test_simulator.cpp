@@ -353,19 +353,26 @@ objects:
   EXPECT_EQ(sc.objects[2].forced_class, core::CellClass::kMoving);
 }
 
+namespace {
+
+/// The parameter a scenario text is refused for ("no error" when it loads).
+std::string keyOf(const std::string& text)
+{
+  try
+  {
+    parseScenario(text, "");
+  }
+  catch (const core::ParameterError& e)
+  {
+    return e.parameter();
+  }
+  return "no error";
+}
+
+}  // namespace
+
 TEST(SimScenario, ErrorsNameTheKey)
 {
-  auto keyOf = [](const std::string& text) {
-    try
-    {
-      parseScenario(text, "");
-    }
-    catch (const core::ParameterError& e)
-    {
-      return e.parameter();
-    }
-    return std::string("no error");
-  };
   const std::string ego = "ego: {route: [[0, 0]], speed: 0}\n";
   EXPECT_EQ(keyOf(ego + "lidar: {preset: vlp32, max_range: -1}"), "lidar.max_range");
   EXPECT_EQ(keyOf(ego + "lidar: {preset: velodyne}"), "lidar.preset");
@@ -385,17 +392,6 @@ TEST(SimScenario, ErrorsNameTheKey)
 
 TEST(SimScenario, UnknownKeysAreErrorsNamingThem)
 {
-  auto keyOf = [](const std::string& text) {
-    try
-    {
-      parseScenario(text, "");
-    }
-    catch (const core::ParameterError& e)
-    {
-      return e.parameter();
-    }
-    return std::string("no error");
-  };
   const std::string ego = "ego: {route: [[0, 0]], speed: 0}\n";
   EXPECT_EQ(keyOf(ego + "speeed: 3"), "speeed");
   EXPECT_EQ(keyOf("ego: {route: [[0, 0]], sped: 2}"), "ego.sped");
