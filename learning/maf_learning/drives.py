@@ -349,9 +349,6 @@ def generate(template, drive, road_map=None):
             return cx, cy, heading, e, side, s
         return None
 
-    def vehicle_kind():
-        return _weighted(rng, VEHICLE_KINDS)
-
     for _ in range(_count(rng, t.get("parked", [3, 8]))):
         kind = "car" if rng.random() < 0.85 else "van"
         spot = kerb_spot(kind)
@@ -378,7 +375,7 @@ def generate(template, drive, road_map=None):
                         "end": "vanish"})
 
     for k in range(_count(rng, t.get("traffic", [2, 6]))):
-        kind = vehicle_kind()
+        kind = _weighted(rng, VEHICLE_KINDS)
         speed = _uniform(rng, t.get("traffic_speed", [6.0, 12.0]))
         if k == 0:  # one vehicle ahead of the ego on its own route
             line = geo.sub_line(ego_line, min(25.0, geo.length(ego_line) / 3), geo.length(ego_line))
@@ -454,7 +451,7 @@ def generate(template, drive, road_map=None):
         o["id"] = i + 1
     objects = [dict([("id", o.pop("id"))] + list(o.items())) for o in objects]
 
-    presets = drive.get("preset") or _weighted(rng, sorted(t.get("lidar_presets", {"vlp32": 1.0}).items()))
+    preset = drive.get("preset") or _weighted(rng, sorted(t.get("lidar_presets", {"vlp32": 1.0}).items()))
     scenario = {
         "name": drive_name(drive),
         "map": t["map_path"],
@@ -463,7 +460,7 @@ def generate(template, drive, road_map=None):
         "seed": seed,
         "default_building_height": float(t.get("default_building_height", 10.0)),
         "tf_rate_hz": 100.0,
-        "lidar": {"preset": presets},
+        "lidar": {"preset": preset},
         "ground_truth": {"size_x": 100.0, "size_y": 100.0, "resolution": 0.5, "stop_speed": 0.1},
         "ego": ego,
     }

@@ -74,21 +74,13 @@ class Drive:
             return ibeo
         return os.path.join(config_dir, "scan_grid.yaml")
 
-    def evaluate(self, evaluate, config_dir, variant="default", timeout=600, out_dir=None):
+    def evaluate(self, evaluate, config_dir, variant="default", timeout=600):
         """metrics.json's scores of `variant` (default: the configured method of config_dir; paper: the paper's)."""
-        origin = ",".join(str(v) for v in self.template["map_origin"])
-        tmp = out_dir or tempfile.mkdtemp(prefix="maf_eval_")
-        cmd = [evaluate, "--bag", self.bag, "--out", tmp, "--fusion-config", os.path.join(config_dir, "fusion.yaml"),
-               "--scan-grid-config", self.scan_grid_config(config_dir),
-               "--prior-config", os.path.join(config_dir, "prior_grid.yaml"), "--map", self.template["map_path"],
-               "--origin", origin, "--only", variant, "--no-ablations", "--quiet"]
+        extra = ["--map", self.template["map_path"], "--origin", ",".join(str(v) for v in self.template["map_origin"])]
         if self.pose_covariance:
-            cmd += ["--pose-covariance-topic", "/localisation/pose"]
-        try:
-            return _run_evaluate(cmd, tmp, variant, self.name, timeout)
-        finally:
-            if out_dir is None:
-                shutil.rmtree(tmp, ignore_errors=True)
+            extra += ["--pose-covariance-topic", "/localisation/pose"]
+        return run_evaluate(evaluate, self.bag, config_dir, self.scan_grid_config(config_dir), variant, self.name,
+                            timeout, extra)
 
 
 def _last_line(text):
@@ -96,18 +88,25 @@ def _last_line(text):
     return lines[-1] if lines else "no message"
 
 
-def _run_evaluate(cmd, out_dir, variant, what, timeout):
+def run_evaluate(evaluate, bag, config_dir, scan_grid_config, variant, what, timeout, extra=()):
+    """`evaluate --only variant` of config_dir on bag (in a temporary folder): the variant's metrics.json scores."""
+    out_dir = tempfile.mkdtemp(prefix="maf_eval_")
+    cmd = [evaluate, "--bag", bag, "--out", out_dir, "--fusion-config", os.path.join(config_dir, "fusion.yaml"),
+           "--scan-grid-config", scan_grid_config, "--prior-config", os.path.join(config_dir, "prior_grid.yaml"),
+           "--only", variant, "--no-ablations", "--quiet", *extra]
     try:
-        r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        raise EvaluationError(f"evaluate timed out after {timeout} s on {what}")
-    if r.returncode != 0:
-        raise EvaluationError(f"evaluate failed on {what} (exit {r.returncode}): {_last_line(r.stderr)}")
-    try:
+        try:
+            r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            raise EvaluationError(f"evaluate timed out after {timeout} s on {what}")
+        if r.returncode != 0:
+            raise EvaluationError(f"evaluate failed on {what} (exit {r.returncode}): {_last_line(r.stderr)}")
         with open(os.path.join(out_dir, "metrics.json")) as f:
             return json.load(f)["variants"][variant]
     except (OSError, ValueError, KeyError) as e:
         raise EvaluationError(f"evaluate wrote no scores of '{variant}' for {what}: {e}")
+    finally:
+        shutil.rmtree(out_dir, ignore_errors=True)
 
 
 def kitti_bag(work_dir, kitti_to_bag, source=KITTI_DIR):
@@ -126,12 +125,5 @@ def kitti_bag(work_dir, kitti_to_bag, source=KITTI_DIR):
 
 def evaluate_kitti(evaluate, bag, config_dir, variant="default", timeout=600):
     """The labelled-point summary of `variant` on the KITTI bag (no map: the sequence has none)."""
-    tmp = tempfile.mkdtemp(prefix="maf_kitti_")
-    cmd = [evaluate, "--bag", bag, "--out", tmp, "--fusion-config", os.path.join(config_dir, "fusion.yaml"),
-           "--scan-grid-config", os.path.join(config_dir, "scan_grid.yaml"),
-           "--prior-config", os.path.join(config_dir, "prior_grid.yaml"), "--only", variant, "--no-ablations",
-           "--quiet"]
-    try:
-        return _run_evaluate(cmd, tmp, variant, "the KITTI frames", timeout)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+    return run_evaluate(evaluate, bag, config_dir, os.path.join(config_dir, "scan_grid.yaml"), variant,
+                        "the KITTI frames", timeout)

@@ -227,10 +227,7 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
     fusionChunk(in.offset(begin, end - begin), w, has_prior, wall, paper, partial[c]);
   };
-  if (parallel)
-    parallel->forChunks(chunks, chunk);
-  else
-    for (std::size_t c = 0; c < chunks; ++c) chunk(c);
+  orSerial(parallel).forChunks(chunks, chunk);
   FusionStepStats total;
   for (const FusionStepStats& p : partial)
   {

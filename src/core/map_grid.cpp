@@ -108,8 +108,7 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out,
                  const ObstaclePoints* obstacles, int clearance_cells, const Parallel* parallel)
 {
-  const Parallel serial(1);
-  const Parallel& par = parallel ? *parallel : serial;
+  const Parallel& par = orSerial(parallel);
   if (out.geometry() != window) out.reset(window);
   const GridGeometry& sg = scan.geometry();
   // m(∅) of a ScanGrid is not used by the fusion: only F, O and Ω are mapped (∅ stays 0 in out).
@@ -241,8 +240,7 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
 void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
                         const Parallel* parallel)
 {
-  const Parallel serial(1);
-  const Parallel& par = parallel ? *parallel : serial;
+  const Parallel& par = orSerial(parallel);
   if (out.building.size() != window.numCells() || out.wall.size() != window.numCells())
     out.reset(window);
   out.geometry = window;
@@ -297,26 +295,25 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
 {
   const std::size_t n = grid.numCells();
   out.resize(n);
-  const Parallel serial(1);
-  const Parallel& par = parallel ? *parallel : serial;
+  const Parallel& par = orSerial(parallel);
   const float* omega = grid.plane(FrameMG::kOmega);
   const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
   const float t = static_cast<float>(threshold);
   std::int8_t* const d = out.data();
   par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
-  for (std::size_t i = i0; i < i1; ++i)
-  {
-    float best_p = p[0][i];
-    std::int8_t best = 0;
-    for (int e = 1; e < FrameMG::kSize; ++e)
+    for (std::size_t i = i0; i < i1; ++i)
     {
-      const bool better = p[e][i] > best_p;
-      best_p = better ? p[e][i] : best_p;
-      best = better ? static_cast<std::int8_t>(e) : best;
+      float best_p = p[0][i];
+      std::int8_t best = 0;
+      for (int e = 1; e < FrameMG::kSize; ++e)
+      {
+        const bool better = p[e][i] > best_p;
+        best_p = better ? p[e][i] : best_p;
+        best = better ? static_cast<std::int8_t>(e) : best;
+      }
+      const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
+      d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
     }
-    const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
-    d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
-  }
   });
 }
 
@@ -334,8 +331,7 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
   const float t = static_cast<float>(params.decision_threshold);
   const auto unknown = static_cast<std::int8_t>(CellClass::kUnknown);
   std::int8_t* const d = out.data();
-  const Parallel serial(1);
-  (parallel ? *parallel : serial).forRange(out.size(), kCellChunk, [&](std::size_t i0, std::size_t i1) {
+  orSerial(parallel).forRange(out.size(), kCellChunk, [&](std::size_t i0, std::size_t i1) {
     for (std::size_t i = i0; i < i1; ++i)
     {
       const bool tie = (d[i] == stopped || d[i] == moving) && std::abs(ps[i] - pv[i]) < margin;
@@ -591,8 +587,7 @@ void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow&
 void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain, AlignedVector<float>& doubt,
                       const Parallel* parallel)
 {
-  const Parallel serial(1);
-  const Parallel& par = parallel ? *parallel : serial;
+  const Parallel& par = orSerial(parallel);
   const std::size_t n = prior.geometry.numCells();
   if (doubt.size() != n) doubt.assign(n, 0.0f);
   const float g = static_cast<float>(gain);
@@ -600,18 +595,18 @@ void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain,
   const float* so = scan.plane(FrameSG::kO);
   float* const eta_out = doubt.data();
   par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
-  for (std::size_t i = i0; i < i1; ++i)
-  {
-    const float k = prior.building[i] * sf[i];
-    const float a = (prior.building[i] + prior.wall[i]) * so[i];
-    const float eta = std::clamp(eta_out[i] + g * (k - a), 0.0f, 1.0f);
-    eta_out[i] = eta;
-    const float keep = 1.0f - eta;
-    prior.building[i] *= keep;
-    prior.road[i] *= keep;
-    prior.other[i] *= keep;
-    prior.wall[i] *= keep;
-  }
+    for (std::size_t i = i0; i < i1; ++i)
+    {
+      const float k = prior.building[i] * sf[i];
+      const float a = (prior.building[i] + prior.wall[i]) * so[i];
+      const float eta = std::clamp(eta_out[i] + g * (k - a), 0.0f, 1.0f);
+      eta_out[i] = eta;
+      const float keep = 1.0f - eta;
+      prior.building[i] *= keep;
+      prior.road[i] *= keep;
+      prior.other[i] *= keep;
+      prior.wall[i] *= keep;
+    }
   });
 }
 

@@ -42,6 +42,12 @@ Parallel::Parallel(int threads) : threads_(resolveThreads(threads))
 
 Parallel::~Parallel() = default;
 
+const Parallel& Parallel::serial()
+{
+  static const Parallel one(1);
+  return one;
+}
+
 void Parallel::forChunks(std::size_t chunks, const std::function<void(std::size_t)>& body) const
 {
   if (chunks == 0) return;

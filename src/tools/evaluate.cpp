@@ -114,6 +114,16 @@ core::ScanGridParams scanGridParams(const YAML::Node& n)
   return p;
 }
 
+/// The PriorGrid parameters of the prior config (map, β, cell test, accuracies), β and options validated.
+map_io::PriorGridParams priorGridParams(const YAML::Node& n)
+{
+  map_io::PriorGridParams p;
+  map_io::forEachPriorGridParam(p, map_io::yamlReader(n));
+  p.beta.validate();
+  p.options.validate();
+  return p;
+}
+
 /// "applied 600" or "no_time_field 10", "applied 580, time_out_of_sweep 20"...
 std::string deskewSummary(const std::map<std::string, std::size_t>& status)
 {
@@ -293,8 +303,8 @@ struct MapSource
 std::optional<MapSource> loadMap(const Options& o, const YAML::Node& prior_cfg, std::string& summary)
 {
   MapSource src;
+  src.params = priorGridParams(prior_cfg);
   map_io::PriorGridParams& pp = src.params;
-  map_io::forEachPriorGridParam(pp, map_io::yamlReader(prior_cfg));
   if (!o.map.empty()) pp.map.file = o.map;
   if (pp.map.file.empty())
   {
@@ -307,8 +317,6 @@ std::optional<MapSource> loadMap(const Options& o, const YAML::Node& prior_cfg, 
     pp.map.origin_longitude = (*o.origin)[1];
     pp.map.origin_altitude = (*o.origin)[2];
   }
-  pp.beta.validate();
-  pp.options.validate();
   map_io::MapLoadReport report;
   src.map = map_io::loadVectorMap(pp.map, &report);
   summary = pp.map.file + ": " + std::to_string(src.map.buildings.size()) + " buildings, " +
@@ -369,10 +377,7 @@ int main(int argc, char** argv)
     configured.scan_grid = scanGridParams(scan_cfg);
     if (opt.check_config)
     {
-      map_io::PriorGridParams pp;
-      map_io::forEachPriorGridParam(pp, map_io::yamlReader(prior_cfg));
-      pp.beta.validate();
-      pp.options.validate();
+      priorGridParams(prior_cfg);
       std::cout << "configuration valid\n";
       return 0;
     }

@@ -39,7 +39,7 @@ def test_geometry_offsets_and_arc_length():
 def test_road_graphs_of_both_maps(maps):
     town, village = maps["town"][1], maps["village"][1]
     assert len(town.roads) == 7 and len(town.buildings) == 23  # maps/README.md (footway not drivable)
-    # the grid town: junctions of four roads; the village: none of its junctions is a grid's four-way crossing
+    # the grid town has four-way junctions (a node of the road graph with four road pieces)
     assert max(len(a) for a in town.adjacent.values()) == 4
     assert len(village.roads) == 4 and len(village.buildings) >= 40
     # no village building on a road surface (the generator's own rule)
@@ -65,7 +65,7 @@ def test_drives_place_objects_clear_of_buildings_and_routes_on_roads(maps, name)
     for seed in SEEDS:
         sc = drives.generate(t, {"template": name, "seed": seed, "duration": 20.0}, rm)
         route = sc["ego"]["route"]
-        assert geo.length(route) >= sc["ego"]["speed"] * 20.0 - 1.0 or len(route) >= 2
+        assert geo.length(route) >= sc["ego"]["speed"] * 20.0, (seed, "the route ends before the drive does")
         for p in route:
             assert min(geo.dist_point_polyline(p, line) - w / 2 for line, w, _ in rm.roads) <= 0.01, (seed, p)
         for o in sc["objects"]:

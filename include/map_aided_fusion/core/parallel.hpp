@@ -47,6 +47,9 @@ public:
   /// Threads jobs run on (≥ 1).
   int threads() const { return threads_; }
 
+  /// A shared one-thread instance: every job inline on the caller.
+  static const Parallel& serial();
+
   /**
    * Runs body(c) for every chunk c in [0, chunks), each exactly once, in any order and on any of the threads;
    * returns when all are done. Exceptions thrown by body are rethrown here.
@@ -61,6 +64,9 @@ private:
   int threads_;
   std::unique_ptr<Arena> arena_;
 };
+
+/// @p parallel, or the serial instance when it is null (the optional argument of the pipeline's functions).
+inline const Parallel& orSerial(const Parallel* parallel) { return parallel ? *parallel : Parallel::serial(); }
 
 /// Number of chunks of @p chunk items that cover n items.
 inline std::size_t chunkCount(std::size_t n, std::size_t chunk) { return chunk == 0 ? 0 : (n + chunk - 1) / chunk; }
