@@ -8,6 +8,7 @@
 #include "map_aided_fusion/core/counter.hpp"
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/frame.hpp"
+#include "map_aided_fusion/core/mass_grid.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__)
 #define MAF_UNROLL _Pragma("GCC unroll 64")
@@ -33,6 +34,8 @@ namespace core {
 namespace kernels {
 
 constexpr int kSubsets = FrameMG::kNumSubsets;
+/// Planes of a MapGrid: the stored subsets, then ζ.
+constexpr int kMapPlanes = MapMassGrid::kNumPlanes;
 
 /// Eight floats processed together (GCC/Clang vector extension: AVX registers in the AVX2 clone,
 /// pairs of SSE registers otherwise). The kernels below are templates on the lane type T, which is
@@ -70,6 +73,25 @@ MAF_INLINE Vec8 load<Vec8>(const float* p)
 }
 MAF_INLINE void store(float* p, float v) { *p = v; }
 MAF_INLINE void store(float* p, Vec8 v) { __builtin_memcpy(p, &v, sizeof v); }
+
+/// m[a] of one cell of a MapGrid's planes (slot order from @p base, @p stride floats apart); a subset the grid does
+/// not store is a compile-time zero, so the arithmetic on it folds away where the translation unit allows it.
+template <typename T>
+MAF_INLINE void loadMasses(const float* base, std::size_t stride, std::size_t i, T (&m)[kSubsets])
+{
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a)
+    m[a] = MapMassGrid::kSlots[a] >= 0 ? load<T>(base + MapMassGrid::kSlots[a] * stride + i) : T{};
+}
+
+/// Stores the stored subsets of @p m (the others must be zero: they are not kept).
+template <typename T>
+MAF_INLINE void storeMasses(float* base, std::size_t stride, std::size_t i, const T (&m)[kSubsets])
+{
+  MAF_UNROLL
+  for (int a = 0; a < kSubsets; ++a)
+    if (MapMassGrid::kSlots[a] >= 0) store(base + MapMassGrid::kSlots[a] * stride + i, m[a]);
+}
 
 /// Sum of the lanes.
 MAF_INLINE float horizontalSum(float v) { return v; }

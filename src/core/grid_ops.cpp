@@ -28,10 +28,12 @@ void refineGrid(const ScanMassGrid& scan, MapMassGrid& out)
   const float* __restrict f = scan.plane(FrameSG::kF);
   const float* __restrict o = scan.plane(FrameSG::kO);
   const float* __restrict w = scan.plane(FrameSG::kOmega);
-  for (int a = 0; a < kSubsets; ++a)
+  (void)e;  // m_SG(∅) has no plane in a MapGrid; the fusion never reads it
+  for (int a = 1; a < kSubsets; ++a)
   {
+    if (!MapMassGrid::stored(static_cast<Subset>(a))) continue;
     float* __restrict dst = out.plane(static_cast<Subset>(a));
-    const float* src = a == 0 ? e : a == FrameMG::kF ? f : a == FrameMG::kO ? o : a == FrameMG::kOmega ? w : nullptr;
+    const float* src = a == FrameMG::kF ? f : a == FrameMG::kO ? o : a == FrameMG::kOmega ? w : nullptr;
     if (src)
       std::copy(src, src + n, dst);
     else
@@ -46,18 +48,17 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
   requireSameGeometry(grid.geometry(), prior.geometry, "combineWithPriorGrid");
   const std::size_t n = grid.numCells();
   const std::size_t stride = grid.stride();
-  float* __restrict base = grid.plane(0);
+  float* __restrict base = grid.planes();
   const float* __restrict pb = prior.building.data();
   const float* __restrict pr = prior.road.data();
   const float* __restrict pt = prior.other.data();
   const float* __restrict pw = prior.wall.data();
   const float threshold = static_cast<float>(kTotalConflictThreshold);
-  kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, base, stride, kernels::kMapPlanes, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     using kernels::load;
     T m[kSubsets];
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = load<T>(base + a * stride + i);
+    kernels::loadMasses(base, stride, i, m);
     const T b = load<T>(pb + i), r = load<T>(pr + i), t = load<T>(pt + i), wl = load<T>(pw + i);
     const T one = kernels::splat<T>(1.0f), zero{};
     const T u = one - b - r - t - wl;
@@ -79,8 +80,7 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) c[a] *= inv;
     c[FrameMG::kOmega] += kernels::select(total, one, zero);
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, c[a]);
+    kernels::storeMasses(base, stride, i, c);
   });
 }
 
@@ -90,16 +90,14 @@ void contextualDiscountGrid(MapMassGrid& grid, const ContextualRates& rates)
   const ContextualDiscountWeights<float> w(rates);
   const std::size_t n = grid.numCells();
   const std::size_t stride = grid.stride();
-  float* __restrict base = grid.plane(0);
+  float* __restrict base = grid.planes();
   const kernels::ContextualDiscountWeights8 w8(w);
-  kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, base, stride, kernels::kMapPlanes, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     T m[kSubsets];
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = kernels::load<T>(base + a * stride + i);
+    kernels::loadMasses(base, stride, i, m);
     kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
+    kernels::storeMasses(base, stride, i, m);
   });
 }
 
@@ -111,21 +109,18 @@ void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassG
   if (&out != &map && out.geometry() != map.geometry()) out.reset(map.geometry());
   const std::size_t n = map.numCells();
   const std::size_t stride = map.stride();
-  const float* mb = map.plane(0);
-  const float* sb = scan.plane(0);
-  float* ob = out.plane(0);
+  const float* mb = map.planes();
+  const float* sb = scan.planes();
+  float* ob = out.planes();
   if (&out != &map) std::copy(map.counter(), map.counter() + n, out.counter());
   kernels::forEachCell(n, nullptr, stride, 0, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     using kernels::load;
     T m1[kSubsets], m2[kSubsets], c[kSubsets];
+    kernels::loadMasses(mb, stride, i, m1);
+    kernels::loadMasses(sb, stride, i, m2);
     MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a)
-    {
-      m1[a] = load<T>(mb + a * stride + i);
-      m2[a] = load<T>(sb + a * stride + i);
-      c[a] = T{};
-    }
+    for (int a = 0; a < kSubsets; ++a) c[a] = T{};
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a)
     {
@@ -137,8 +132,7 @@ void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassG
     c[FrameMG::kV] += fo;
     c[FrameMG::kOmega] += c[0] - fo;
     c[0] = T{};
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) kernels::store(ob + a * stride + i, c[a]);
+    kernels::storeMasses(ob, stride, i, c);
     if (conflict_free_occupied) kernels::store(conflict_free_occupied + i, fo);
     if (conflict_occupied_free) kernels::store(conflict_occupied_free + i, of);
   });
@@ -151,23 +145,21 @@ void updateCounterAndSpecialiseGrid(MapMassGrid& grid, const float* conflict_fre
   params.validate();
   const std::size_t n = grid.numCells();
   const std::size_t stride = grid.stride();
-  float* __restrict base = grid.plane(0);
+  float* __restrict base = grid.planes();
   float* __restrict zeta = grid.counter();
   const float di = static_cast<float>(params.delta_inc), dd = static_cast<float>(params.delta_dec);
   const float go = static_cast<float>(params.gamma_occupied), gc = static_cast<float>(params.gamma_conflict);
   const bool literal = params.mode == SpecialisationMode::kLiteral;
-  kernels::forEachCell(n, base, stride, kSubsets + 1, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, base, stride, kernels::kMapPlanes + 1, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     using kernels::load;
     T m[kSubsets];
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = load<T>(base + a * stride + i);
+    kernels::loadMasses(base, stride, i, m);
     const T conflict = load<T>(conflict_free_occupied + i) + load<T>(conflict_occupied_free + i);
     const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m), conflict, di, dd, go, gc);
     kernels::store(zeta + i, z);
     kernels::specialise(m, z, literal);
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) kernels::store(base + a * stride + i, m[a]);
+    kernels::storeMasses(base, stride, i, m);
   });
 }
 
@@ -177,17 +169,16 @@ void pignisticGrid(const MapMassGrid& grid, PignisticPlanes& out)
   const std::size_t n = grid.numCells();
   const std::size_t stride = grid.stride();
   for (auto& p : out.p) p.resize(n);
-  const float* __restrict base = grid.plane(0);
+  const float* __restrict base = grid.planes();
   float* __restrict p0 = out.p[0].data();
   float* __restrict p1 = out.p[1].data();
   float* __restrict p2 = out.p[2].data();
   float* __restrict p3 = out.p[3].data();
   float* __restrict p4 = out.p[4].data();
-  kernels::forEachCell(n, base, stride, kSubsets, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, base, stride, kernels::kMapPlanes, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     T m[kSubsets];
-    MAF_UNROLL
-    for (int a = 0; a < kSubsets; ++a) m[a] = kernels::load<T>(base + a * stride + i);
+    kernels::loadMasses(base, stride, i, m);
     T p[FrameMG::kSize];
     kernels::pignistic(m, p);
     kernels::store(p0 + i, p[0]);

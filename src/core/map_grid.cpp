@@ -50,6 +50,36 @@ void copyCell(const MassGrid<Frame>& from, std::size_t i, MassGrid<Frame>& to, s
   for (int a = 0; a < Frame::kNumSubsets; ++a) to.plane(static_cast<Subset>(a))[j] = from.plane(static_cast<Subset>(a))[i];
 }
 
+/// The 8-connected region of @p start (which @p member must accept) among the cells @p member accepts, depth first,
+/// into @p region; its cells are marked in @p seen.
+template <class Member>
+void growRegion(const GridGeometry& g, std::size_t start, Member&& member, std::vector<std::uint8_t>& seen,
+                std::vector<std::size_t>& stack, std::vector<std::size_t>& region)
+{
+  region.clear();
+  stack.assign(1, start);
+  seen[start] = 1;
+  while (!stack.empty())
+  {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    region.push_back(i);
+    const CellIndex c = g.cellOf(i);
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+      {
+        const CellIndex nb{ c.x + dx, c.y + dy };
+        if (!g.contains(nb)) continue;
+        const std::size_t j = g.index(nb);
+        if (!seen[j] && member(j))
+        {
+          seen[j] = 1;
+          stack.push_back(j);
+        }
+      }
+  }
+}
+
 }  // namespace
 
 void MapGridParams::validate() const
@@ -87,7 +117,7 @@ void MapGridParams::validate() const
 
 std::size_t MapGridParams::bytesPerCell()
 {
-  const std::size_t planes = (FrameMG::kNumSubsets + 1)   // masses and ζ
+  const std::size_t planes = (MapMassGrid::kNumPlanes + 1)  // the stored masses and ζ
                              + FrameMG::kSize              // BetP
                              + FrameSG::kNumSubsets        // the scan projected into the window
                              + 4                           // the prior window (building, road, other, wall)
@@ -99,6 +129,33 @@ double MapGridParams::bytesNeeded() const
 {
   return std::round(size_x / resolution) * std::round(size_y / resolution) * static_cast<double>(bytesPerCell());
 }
+
+namespace {
+
+struct ScanPlanes
+{
+  const float* f;
+  const float* o;
+  const float* omega;
+};
+
+/// Window cells [x0, x1) of one row, all inside the scan grid: each takes the scan cell under (fxr + x dfx,
+/// fyr + x dfy) (scan cells); with @p points the occupied mass goes to Ω (point occupancy marks it later).
+MAF_TARGET_CLONES
+void sampleRun(ScanPlanes scan, int scan_width, double fxr, double fyr, double dfx, double dfy, int x0, int x1,
+               bool points, float* __restrict f, float* __restrict o, float* __restrict omega)
+{
+  for (int x = x0; x < x1; ++x)
+  {
+    const double fx = fxr + x * dfx, fy = fyr + x * dfy;
+    const int i = static_cast<int>(fy) * scan_width + static_cast<int>(fx);
+    f[x] = scan.f[i];
+    o[x] = points ? 0.0f : scan.o[i];
+    omega[x] = points ? scan.omega[i] + scan.o[i] : scan.omega[i];
+  }
+}
+
+}  // namespace
 
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)
 {
@@ -129,31 +186,60 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
   const double fx00 = (c * dx0 + s * dy0 - sg.origin_x) * inv_res, fy00 = (-s * dx0 + c * dy0 - sg.origin_y) * inv_res;
   const double drx = s * window.resolution * inv_res, dry = c * window.resolution * inv_res;  // per window row
   const double sw_max = sg.width, sh_max = sg.height;
-  // One band of kProjectTile rows per chunk: each writes its own rows.
+  // Each predicate of "inside the scan grid" is monotone along a row (fx, fy are linear in x and rounding is monotone),
+  // so the window cells that sample the scan grid are one interval per row: it is bracketed from the exact bounds
+  // and then trimmed with the very test a per-cell check would use, so the samples are those of a per-cell check.
+  auto inside = [&](double fxr, double fyr, int x) {
+    const double fx = fxr + x * dfx, fy = fyr + x * dfy;
+    return fx >= 0.0 && fy >= 0.0 && fx < sw_max && fy < sh_max;
+  };
+  auto row_interval = [&](double fxr, double fyr, int& x0, int& x1) {
+    double lo = 0.0, hi = w;
+    auto clip = [&](double f0, double df, double max) {  // 0 <= f0 + x df < max
+      if (df == 0.0)
+      {
+        if (!(f0 >= 0.0 && f0 < max)) hi = lo;
+        return;
+      }
+      const double a = (0.0 - f0) / df, b = (max - f0) / df;
+      lo = std::max(lo, std::min(a, b));
+      hi = std::min(hi, std::max(a, b));
+    };
+    clip(fxr, dfx, sw_max);
+    clip(fyr, dfy, sh_max);
+    constexpr int kBracket = 2;
+    x0 = hi <= lo ? 0 : static_cast<int>(std::clamp(std::floor(lo) - kBracket, 0.0, static_cast<double>(w)));
+    x1 = hi <= lo ? 0 : static_cast<int>(std::clamp(std::ceil(hi) + kBracket, 0.0, static_cast<double>(w)));
+    while (x0 < x1 && !inside(fxr, fyr, x0)) ++x0;
+    while (x1 > x0 && !inside(fxr, fyr, x1 - 1)) --x1;
+  };
+  // One band of kProjectTile rows per chunk: each writes its own rows, in tiles that keep the rotated reads local.
   par.forChunks(chunkCount(static_cast<std::size_t>(h), kProjectTile), [&](std::size_t band) {
     const int ty = static_cast<int>(band) * kProjectTile;
+    const int ty1 = std::min(h, ty + kProjectTile);
+    int lo[kProjectTile], hi[kProjectTile];
+    for (int y = ty; y < ty1; ++y)
+    {
+      row_interval(fx00 + y * drx, fy00 + y * dry, lo[y - ty], hi[y - ty]);
+      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+      const int l = lo[y - ty], r = hi[y - ty];
+      for (const auto [b, e] : { std::pair{ 0, l }, std::pair{ r, w } })  // vacuous outside the scan grid
+      {
+        std::fill(df + row + b, df + row + e, 0.0f);
+        std::fill(d_o + row + b, d_o + row + e, 0.0f);
+        std::fill(dw + row + b, dw + row + e, 1.0f);
+      }
+    }
     for (int tx = 0; tx < w; tx += kProjectTile)
-      for (int y = ty; y < std::min(h, ty + kProjectTile); ++y)
+      for (int y = ty; y < ty1; ++y)
       {
         const double fxr = fx00 + y * drx, fyr = fy00 + y * dry;
         const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-        for (int x = tx; x < std::min(w, tx + kProjectTile); ++x)
-        {
-          const double fx = fxr + x * dfx, fy = fyr + x * dfy;
-          const std::size_t j = row + static_cast<std::size_t>(x);
-          if (fx >= 0.0 && fy >= 0.0 && fx < sw_max && fy < sh_max)
-          {
-            const std::size_t i = static_cast<std::size_t>(static_cast<int>(fy) * sg.width + static_cast<int>(fx));
-            df[j] = sf[i];
-            d_o[j] = points ? 0.0f : s_o[i];
-            dw[j] = points ? sw[i] + s_o[i] : sw[i];
-          }
-          else
-          {
-            df[j] = d_o[j] = 0.0f;
-            dw[j] = 1.0f;
-          }
-        }
+        const int x_end = std::min({ w, tx + kProjectTile, hi[y - ty] });
+        const int x0 = std::max(tx, lo[y - ty]);
+        if (x0 < x_end)
+          sampleRun(ScanPlanes{ sf, s_o, sw }, sg.width, fxr, fyr, dfx, dfy, x0, x_end, points, df + row, d_o + row,
+                    dw + row);
       }
   });
   if (points)
@@ -342,7 +428,7 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
 }
 
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
-                         int max_cells, double threshold, double margin)
+                         int max_cells, double threshold, double margin, const Parallel* parallel)
 {
   if (share <= 0.0) return 0;
   const GridGeometry& g = grid.geometry();
@@ -352,58 +438,48 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
   const float* pv = betp[FrameMG::kSize - 1].data();
   const float t = static_cast<float>(threshold);
   const float m = static_cast<float>(margin);
-  thread_local std::vector<std::uint8_t> seen;
-  thread_local std::vector<std::size_t> stack, region;
-  seen.assign(n, 0);
+  auto is_moving = [&](std::size_t i) { return pv[i] >= t && pv[i] - ps[i] > m; };
+  // A region without a moving cell is left alone: only the occupied moving cells seed one. They are found by fixed
+  // chunks in parallel and taken in index order, so the regions (disjoint) are the same for any thread count.
+  const std::size_t chunks = chunkCount(n, kCellChunk);
+  std::vector<std::vector<std::size_t>> seeds(chunks);
+  orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
+    for (std::size_t i = c * kCellChunk, end = std::min(n, i + kCellChunk); i < end; ++i)
+      if (so[i] > 0.0f && is_moving(i)) seeds[c].push_back(i);
+  });
+  std::vector<std::uint8_t> seen(n, 0);
+  std::vector<std::size_t> stack, region;
   std::size_t spread = 0;
-  for (std::size_t start = 0; start < n; ++start)
-  {
-    if (seen[start] || so[start] <= 0.0f) continue;
-    region.clear();
-    stack.assign(1, start);
-    seen[start] = 1;
-    std::size_t moving = 0;
-    while (!stack.empty())
+  float* const base = grid.planes();
+  const std::size_t stride = grid.stride();
+  for (const std::vector<std::size_t>& chunk : seeds)
+    for (const std::size_t start : chunk)
     {
-      const std::size_t i = stack.back();
-      stack.pop_back();
-      region.push_back(i);
-      moving += pv[i] >= t && pv[i] - ps[i] > m;
-      const CellIndex c = g.cellOf(i);
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-        {
-          const CellIndex nb{ c.x + dx, c.y + dy };
-          if (!g.contains(nb)) continue;
-          const std::size_t j = g.index(nb);
-          if (!seen[j] && so[j] > 0.0f)
+      if (seen[start]) continue;
+      growRegion(g, start, [so](std::size_t j) { return so[j] > 0.0f; }, seen, stack, region);
+      std::size_t moving = 0;
+      for (const std::size_t i : region) moving += is_moving(i);
+      if (static_cast<int>(region.size()) > max_cells ||
+          static_cast<double>(moving) < share * static_cast<double>(region.size()))
+        continue;
+      ++spread;
+      for (const std::size_t i : region)
+      {
+        float mass[kernels::kSubsets];
+        kernels::loadMasses(base, stride, i, mass);
+        for (int a = 0; a < kernels::kSubsets; ++a)
+          if ((a & FrameMG::kV) && a != FrameMG::kV && !(a & FrameMG::kF))
           {
-            seen[j] = 1;
-            stack.push_back(j);
+            mass[FrameMG::kV] += mass[a];
+            mass[a] = 0.0f;
           }
-        }
+        kernels::renormalise(mass);
+        kernels::storeMasses(base, stride, i, mass);
+        float p[FrameMG::kSize];
+        kernels::pignistic(mass, p);
+        for (int e = 0; e < FrameMG::kSize; ++e) betp.p[e][i] = p[e];
+      }
     }
-    if (moving == 0 || static_cast<int>(region.size()) > max_cells ||
-        static_cast<double>(moving) < share * static_cast<double>(region.size()))
-      continue;
-    ++spread;
-    for (const std::size_t i : region)
-    {
-      float m[kernels::kSubsets];
-      for (int a = 0; a < kernels::kSubsets; ++a) m[a] = grid.plane(static_cast<Subset>(a))[i];
-      for (int a = 0; a < kernels::kSubsets; ++a)
-        if ((a & FrameMG::kV) && a != FrameMG::kV && !(a & FrameMG::kF))
-        {
-          m[FrameMG::kV] += m[a];
-          m[a] = 0.0f;
-        }
-      kernels::renormalise(m);
-      for (int a = 0; a < kernels::kSubsets; ++a) grid.plane(static_cast<Subset>(a))[i] = m[a];
-      float p[FrameMG::kSize];
-      kernels::pignistic(m, p);
-      for (int e = 0; e < FrameMG::kSize; ++e) betp.p[e][i] = p[e];
-    }
-  }
   return spread;
 }
 
@@ -417,28 +493,7 @@ std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<
   {
     const auto cls = static_cast<CellClass>(decision[start]);
     if (seen[start] || (cls != CellClass::kMoving && cls != CellClass::kStopped)) continue;
-    region.clear();
-    stack.assign(1, start);
-    seen[start] = 1;
-    while (!stack.empty())
-    {
-      const std::size_t i = stack.back();
-      stack.pop_back();
-      region.push_back(i);
-      const CellIndex c = g.cellOf(i);
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-        {
-          const CellIndex n{ c.x + dx, c.y + dy };
-          if (!g.contains(n)) continue;
-          const std::size_t j = g.index(n);
-          if (!seen[j] && decision[j] == decision[start])
-          {
-            seen[j] = 1;
-            stack.push_back(j);
-          }
-        }
-    }
+    growRegion(g, start, [&](std::size_t j) { return decision[j] == decision[start]; }, seen, stack, region);
     if (static_cast<int>(region.size()) < min_cells) continue;
     GridObject o;
     o.cell_class = cls;
@@ -557,12 +612,11 @@ void MapGrid::shift(int dx, int dy)
   }
   // Every plane (the masses, ζ and the map doubt) is its own chunk.
   const bool doubt = map_doubt_.size() == g.numCells();
-  parallel_->forChunks(FrameMG::kNumSubsets + 1 + (doubt ? 1 : 0), [&](std::size_t c) {
+  constexpr int kPlanes = MapMassGrid::kNumPlanes;
+  parallel_->forChunks(kPlanes + 1 + (doubt ? 1 : 0), [&](std::size_t c) {
     const int plane = static_cast<int>(c);
-    float* p = plane == FrameMG::kNumSubsets + 1 ? map_doubt_.data()
-               : plane == FrameMG::kNumSubsets   ? grid_.counter()
-                                                 : grid_.plane(static_cast<Subset>(plane));
-    shiftPlane(p, g, dx, dy, plane == FrameMG::kOmega ? 1.0f : 0.0f);
+    float* p = plane == kPlanes + 1 ? map_doubt_.data() : grid_.planes() + static_cast<std::size_t>(plane) * grid_.stride();
+    shiftPlane(p, g, dx, dy, plane == MapMassGrid::slot(FrameMG::kOmega) ? 1.0f : 0.0f);
   });
 }
 
@@ -660,7 +714,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   FusionStepStats stats;
   fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_, parallel_.get());
   spreadMotion(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells, params_.decision_threshold,
-               params_.motion_margin);
+               params_.motion_margin, parallel_.get());
   t.fusion = secondsSince(t0);
 
   last_stamp_ = stamp;

@@ -95,6 +95,7 @@ void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msg
   msg.focal_sets.clear();
   for (int a = 0; a < Frame::kNumSubsets; ++a)
   {
+    if (!grid.stored(static_cast<Subset>(a))) continue;  // mass 0 in every cell
     const float* p = grid.plane(static_cast<Subset>(a));
     if (planes == PlaneSelection::kAll || std::any_of(p, p + n, [](float v) { return v != 0.0f; }))
       msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
@@ -127,11 +128,20 @@ void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Fram
       throw ConversionError("EvidentialGrid: focal set " + core::subsetName<Frame>(a) + " appears twice");
     seen |= 1ull << a;
   }
+  for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
+  {
+    const auto first = msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n);
+    if (!grid.stored(msg.focal_sets[k]) && std::any_of(first, first + static_cast<std::ptrdiff_t>(n), [](float v) { return v != 0.0f; }))
+      throw ConversionError("EvidentialGrid: mass on focal set " + core::subsetName<Frame>(msg.focal_sets[k]) +
+                            ", which this grid never holds");
+  }
   if (grid.geometry() != g)
     grid.reset(g);
-  for (int a = 0; a < Frame::kNumSubsets; ++a) std::fill_n(grid.plane(static_cast<Subset>(a)), n, 0.0f);
+  for (int a = 0; a < Frame::kNumSubsets; ++a)
+    if (grid.stored(static_cast<Subset>(a))) std::fill_n(grid.plane(static_cast<Subset>(a)), n, 0.0f);
   for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
-    std::copy_n(msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n), n, grid.plane(msg.focal_sets[k]));
+    if (grid.stored(msg.focal_sets[k]))
+      std::copy_n(msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n), n, grid.plane(msg.focal_sets[k]));
   if (msg.counter.empty())
     std::fill_n(grid.counter(), n, 0.0f);
   else

@@ -351,11 +351,12 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   try
   {
     GridConversions::fromMessage(*msg, scan);
+    const float *e = scan.plane(core::FrameSG::kEmpty), *f = scan.plane(core::FrameSG::kF),
+                *o = scan.plane(core::FrameSG::kO), *w = scan.plane(core::FrameSG::kOmega);
     for (std::size_t i = 0; i < scan.numCells(); ++i)
     {
-      const float s = scan.plane(0)[i] + scan.plane(1)[i] + scan.plane(2)[i] + scan.plane(3)[i];
-      if (!(std::abs(s - 1.0f) < 1e-3f) || !(scan.plane(0)[i] >= 0.0f) || !(scan.plane(1)[i] >= 0.0f) ||
-          !(scan.plane(2)[i] >= 0.0f) || !(scan.plane(3)[i] >= 0.0f))
+      const float s = e[i] + f[i] + o[i] + w[i];
+      if (!(std::abs(s - 1.0f) < 1e-3f) || !(e[i] >= 0.0f) || !(f[i] >= 0.0f) || !(o[i] >= 0.0f) || !(w[i] >= 0.0f))
         throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " + std::to_string(s) + ")");
     }
     if (msg->obstacle_points.size() % 2 != 0)

@@ -26,7 +26,7 @@ MapMassGrid randomMapGrid(std::mt19937& rng, const GridGeometry& g, bool with_co
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (std::size_t i = 0; i < grid.numCells(); ++i)
   {
-    grid.setCell(i, randomMass<FrameMG>(rng, 8));
+    grid.setCell(i, randomMass<FrameMG>(rng, 8, false, true));
     if (with_counter) grid.counter()[i] = static_cast<float>(u(rng));
   }
   return grid;
@@ -107,8 +107,25 @@ TEST(GridGeometry, WorldCellRoundTripAndRowMajorIndex)
 TEST(MassGrid, PlanesAreAlignedAndStartVacuous)
 {
   MapMassGrid grid(testGeometry());
+  EXPECT_EQ(MapMassGrid::kNumPlanes, 29) << "the reachable focal sets (ReachableFocalSets)";
+  EXPECT_EQ(ScanMassGrid::kNumPlanes, 4);
+  int slots = 0;
   for (int a = 0; a < 32; ++a)
+  {
+    if (!MapMassGrid::stored(static_cast<Subset>(a)))
+    {
+      EXPECT_THROW(grid.plane(static_cast<Subset>(a)), std::out_of_range) << a;
+      continue;
+    }
+    EXPECT_EQ(MapMassGrid::slot(static_cast<Subset>(a)), slots++);
     EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.plane(static_cast<Subset>(a))) % 64, 0u);
+  }
+  EXPECT_FALSE(MapMassGrid::stored(0));
+  EXPECT_FALSE(MapMassGrid::stored(FrameMG::kC | FrameMG::kV));
+  EXPECT_FALSE(MapMassGrid::stored(FrameMG::kF | FrameMG::kC | FrameMG::kV));
+  EXPECT_EQ(grid.bytes(), grid.stride() * 30 * sizeof(float)) << "29 mass planes and zeta";
+  EXPECT_THROW(grid.setCell(0, MassMG{ { FrameMG::kC | FrameMG::kV, 0.5 }, { FrameMG::kOmega, 0.5 } }),
+               std::invalid_argument);
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.counter()) % 64, 0u);
   for (std::size_t i = 0; i < grid.numCells(); ++i)
   {
@@ -158,7 +175,11 @@ TEST(GridOps, ModifiedYagerMatchesScalar)
 {
   std::mt19937 rng(4);
   const auto a = randomMapGrid(rng, testGeometry());
-  const auto b = randomMapGrid(rng, testGeometry());
+  // The second operand of ⊛ in the pipeline: r(m_SG) ⊕ m_PG (two arbitrary masses could meet in {C, V}, a set the
+  // MapGrid does not store).
+  MapMassGrid b;
+  refineGrid(randomScanGrid(rng, testGeometry()), b);
+  combineWithPriorGrid(b, randomPrior(rng, testGeometry(), PriorConfidence{ 1.0, 0.85, 0.7 }));
   MapMassGrid out;
   std::vector<float> fo(a.numCells()), of(a.numCells());
   modifiedYagerGrid(a, b, out, fo.data(), of.data());

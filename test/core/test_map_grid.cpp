@@ -106,7 +106,7 @@ TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
   auto& grid = mg.masses();
   for (std::size_t i = 0; i < grid.numCells(); ++i)
   {
-    grid.setCell(i, maf_test::randomMass<FrameMG>(rng, 6));
+    grid.setCell(i, maf_test::randomMass<FrameMG>(rng, 6, false, true));
     grid.counter()[i] = static_cast<float>(i % 17) / 17.0f;
   }
   const MapMassGrid before = grid;
@@ -126,7 +126,10 @@ TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
         {
           const std::size_t i = g.index(src);
           for (int a = 0; a < 32; ++a)
-            ASSERT_EQ(moved.masses().plane(static_cast<Subset>(a))[j], before.plane(static_cast<Subset>(a))[i]);
+            if (MapMassGrid::stored(static_cast<Subset>(a)))
+            {
+              ASSERT_EQ(moved.masses().plane(static_cast<Subset>(a))[j], before.plane(static_cast<Subset>(a))[i]);
+            }
           ASSERT_EQ(moved.masses().counter()[j], before.counter()[i]);
           // Same world position before and after.
           const Point2 pw = g.cellCentre(CellIndex{ x, y });
@@ -145,6 +148,45 @@ TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
   far.shift(1000, 0);
   for (std::size_t i = 0; i < far.masses().numCells(); ++i)
     ASSERT_TRUE(maf_test::massNear(far.masses().cell(i), MassMG::vacuous(), 0.0));
+}
+
+TEST(ProjectScan, RotatedWindowSamplesTheScanCellUnderEachCellCentre)
+{
+  // Free and unknown evidence only (no forward pass, no clearance): every window cell takes the scan cell under its
+  // centre, seen from the vehicle, or is vacuous outside the scan grid, for windows that cross the scan's edges.
+  const auto sg = GridGeometry::centred(20.0, 14.0, kRes);
+  ScanMassGrid scan(sg);
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> free_mass(0.0, 1.0);
+  for (std::size_t i = 0; i < scan.numCells(); ++i)
+  {
+    const double f = free_mass(rng);
+    scan.setCell(i, MassSG{ { FrameSG::kF, f }, { FrameSG::kOmega, 1.0 - f } });
+  }
+  std::uniform_real_distribution<double> yaw(-M_PI, M_PI), shift(-6.0, 6.0);
+  const auto window = GridGeometry::centred(30.0, 24.0, kRes);
+  ScanMassGrid out;  // reused: every cell of every trial must be written again
+  for (int trial = 0; trial < 6; ++trial)
+  {
+    const Pose2 pose{ shift(rng), shift(rng), yaw(rng) };
+    projectScan(scan, pose, window, out);
+    std::size_t sampled = 0, mismatches = 0;
+    for (int y = 0; y < window.height; ++y)
+      for (int x = 0; x < window.width; ++x)
+      {
+        const Point2 p = window.cellCentre(CellIndex{ x, y });
+        const double dx = p.x - pose.x, dy = p.y - pose.y;
+        const Point2 v{ std::cos(pose.yaw) * dx + std::sin(pose.yaw) * dy, -std::sin(pose.yaw) * dx + std::cos(pose.yaw) * dy };
+        CellIndex sc;
+        const bool inside = sg.worldToCell(v, sc);
+        sampled += inside;
+        const MassSG expected = inside ? scan.cell(sg.index(sc)) : MassSG::vacuous();
+        mismatches += !maf_test::massNear(out.cell(window.index(x, y)), expected, 1e-6);
+      }
+    EXPECT_GT(sampled, 200u) << "trial " << trial << " must overlap the scan";
+    EXPECT_LT(sampled, window.numCells()) << "trial " << trial << " must cross the scan's edges";
+    EXPECT_EQ(mismatches, 0u) << "trial " << trial << " yaw " << pose.yaw;
+  }
 }
 
 TEST(ProjectScan, IdentityIsAnExactCopyAndRotationLosesNoObstacle)

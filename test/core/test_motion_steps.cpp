@@ -302,7 +302,7 @@ TEST(MotionSteps, MotionSpreadingMakesASmallRegionWithVCellsMovingAndLeavesLarge
   for (std::size_t i = 0; i < geo.numCells(); ++i)
   {
     double sum = 0.0;
-    for (int a = 0; a < FrameMG::kNumSubsets; ++a) sum += g.plane(static_cast<Subset>(a))[i];
+    for (int a = 0; a < FrameMG::kNumSubsets; ++a) sum += g.cell(i)[static_cast<Subset>(a)];
     EXPECT_NEAR(sum, 1.0, 1e-6);
     EXPECT_NEAR(betp[4][i] + betp[0][i] + betp[1][i] + betp[2][i] + betp[3][i], 1.0, 1e-5);
   }

@@ -129,7 +129,8 @@ DriveResult drive(int threads)
   }
   const MapMassGrid& m = grid.masses();
   for (int a = 0; a < FrameMG::kNumSubsets; ++a)
-    r.planes.insert(r.planes.end(), m.plane(static_cast<Subset>(a)), m.plane(static_cast<Subset>(a)) + m.numCells());
+    if (MapMassGrid::stored(static_cast<Subset>(a)))
+      r.planes.insert(r.planes.end(), m.plane(static_cast<Subset>(a)), m.plane(static_cast<Subset>(a)) + m.numCells());
   r.planes.insert(r.planes.end(), m.counter(), m.counter() + m.numCells());
   for (int e = 0; e < FrameMG::kSize; ++e)
     r.betp.insert(r.betp.end(), grid.pignistic()[e].begin(), grid.pignistic()[e].end());

@@ -139,7 +139,8 @@ TEST(StreamHealth, WarnsAndErrsWhenScansStopAndRecovers)
 
 TEST(MemoryBudget, HugeWindowIsRefusedBeforeAllocationWithTheBytesNeeded)
 {
-  EXPECT_EQ(MapGridParams::bytesPerCell(), (32u + 1u + 5u + 4u + 4u + 1u) * sizeof(float) + 1u);
+  // 29 stored focal sets and ζ, BetP, the scan window (4), the prior window (4), the map doubt; the decision.
+  EXPECT_EQ(MapGridParams::bytesPerCell(), (29u + 1u + 5u + 4u + 4u + 1u) * sizeof(float) + 1u);
   MapGridParams p;
   p.size_x = p.size_y = 4096.0;  // 8192 x 8192 cells at 0.5 m: 12 GB
   try
@@ -260,9 +261,10 @@ TEST(Soak, HundredThousandNoisyScansKeepMassFunctionsAndFlatMemory)
       for (std::size_t i = 0; i < m.numCells(); ++i)
       {
         double sum = 0.0;
+        const MassMG cell = m.cell(i);
         for (int a = 0; a < FrameMG::kNumSubsets; ++a)
         {
-          const double v = m.plane(static_cast<Subset>(a))[i];
+          const double v = cell[static_cast<Subset>(a)];
           worst_negative = std::min(worst_negative, v);
           sum += v;
         }

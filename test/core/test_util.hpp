@@ -6,6 +6,7 @@
 #include <random>
 
 #include "map_aided_fusion/core/mass_function.hpp"
+#include "map_aided_fusion/core/mass_grid.hpp"
 
 namespace maf_test {
 
@@ -13,9 +14,9 @@ using map_aided_fusion::core::MassFunction;
 using map_aided_fusion::core::Subset;
 
 /// A random mass function with 1..max_focal focal sets drawn among the subsets of the frame
-/// (∅ excluded unless allow_empty).
+/// (∅ excluded unless allow_empty; with only_stored, only the subsets a MassGrid of the frame stores).
 template <class Frame>
-MassFunction<Frame> randomMass(std::mt19937& rng, int max_focal = 6, bool allow_empty = false)
+MassFunction<Frame> randomMass(std::mt19937& rng, int max_focal = 6, bool allow_empty = false, bool only_stored = false)
 {
   std::uniform_int_distribution<int> count(1, max_focal);
   std::uniform_int_distribution<int> subset(allow_empty ? 0 : 1, Frame::kNumSubsets - 1);
@@ -26,7 +27,9 @@ MassFunction<Frame> randomMass(std::mt19937& rng, int max_focal = 6, bool allow_
   for (int i = 0; i < k; ++i)
   {
     const double w = weight(rng);
-    v[subset(rng)] += w;
+    int a = subset(rng);
+    while (only_stored && !map_aided_fusion::core::MassGrid<Frame>::stored(static_cast<Subset>(a))) a = subset(rng);
+    v[a] += w;
     total += w;
   }
   for (auto& x : v) x /= total;

@@ -16,7 +16,8 @@
 namespace map_aided_fusion {
 namespace core {
 
-/// r_SG on every cell: @p out (same geometry, reset by the call) gets m(F), m(CNSV), m(Ω).
+/// r_SG on every cell: @p out (same geometry, reset by the call) gets m(F), m(CNSV), m(Ω) (m_SG(∅), which the
+/// fusion never reads, has no plane in a MapGrid).
 void refineGrid(const ScanMassGrid& scan, MapMassGrid& out);
 
 /**
@@ -29,7 +30,9 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior);
 void contextualDiscountGrid(MapMassGrid& grid, const ContextualRates& rates);
 
 /**
- * @brief The modified Yager rule ⊛ on every cell: out = map ⊛ scan (out may alias map).
+ * @brief The modified Yager rule ⊛ on every cell: out = map ⊛ scan (out may alias map). @p scan is the pipeline's
+ *        r(m_SG) ⊕ m_PG: with two arbitrary operands, mass meeting in a set the MapGrid does not store ({C, V},
+ *        {F, C, V}; see PlaneLayout) would not be kept.
  * @param conflict_free_occupied  per-cell ∅_FO (numCells floats), or nullptr
  * @param conflict_occupied_free  per-cell ∅_OF (numCells floats), or nullptr
  */

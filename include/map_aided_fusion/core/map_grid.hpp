@@ -229,10 +229,11 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
  * @brief The step "motion spreading" on @p grid and its BetP @p betp (both updated in place): see
  *        MapGridParams::motion_share. @p scan is the scan in the grid's cells. A cell counts as V when
  *        BetP(V) ≥ @p threshold and BetP(V) − BetP(S) > @p margin (an open {S, V} is not motion). Returns the number
- *        of regions spread.
+ *        of regions spread. @p parallel: the threads that look for the moving cells (the result is the same for any
+ *        number).
  */
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
-                         int max_cells, double threshold, double margin);
+                         int max_cells, double threshold, double margin, const Parallel* parallel = nullptr);
 
 /// Decision per cell with every decision parameter of @p params: the threshold, then the step "motion margin"
 /// (S or V decisions within motion_margin of each other, and occupied cells no class decides, become

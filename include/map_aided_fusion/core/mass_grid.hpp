@@ -1,12 +1,16 @@
 /**
  * @file mass_grid.hpp
- * @brief Evidential grids stored as structure-of-arrays: one contiguous float plane per subset of the
- *        frame (indexed by subset mask, ∅ included) plus a plane for the counter ζ.
+ * @brief Evidential grids stored as structure-of-arrays: one contiguous float plane per stored subset of the
+ *        frame plus a plane for the counter ζ. A ScanGrid stores its four subsets; the MapGrid stores only the 29
+ *        focal sets its pipeline can reach (PlaneLayout).
  */
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
+#include <stdexcept>
+#include <string>
 
 #include "map_aided_fusion/core/aligned_vector.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
@@ -21,15 +25,56 @@ constexpr std::size_t kPlaneAlignmentFloats = 16;
 /// share a cache set (a page-multiple stride makes 33 streams fight over the same sets).
 constexpr std::size_t kPlanePageFloats = 1024;
 
+/// Which subsets of @p Frame a MassGrid stores: every one, by default.
+template <class Frame>
+struct PlaneLayout
+{
+  static constexpr bool stored(Subset) { return true; }
+};
+
 /**
- * @brief A grid of mass functions on @p Frame. Plane a (a = subset mask) holds m(a) for every cell,
- *        row-major; plane 2^N holds the counter ζ (used by the MapGrid, zero elsewhere).
+ * @brief The MapGrid's layout: the 29 focal sets the per-scan pipeline can reach from the scan, the prior,
+ *        discounting, ⊛, specialisation and motion spreading. Not stored (always zero): ∅ (⊛ and the other rules leave
+ *        no mass on it), {C, V} and {F, C, V} (contexts add {C, N} or {S, V} whole, and every set of r(m_SG) ⊕ m_PG
+ *        holding C holds N, S and V or neither S nor V). The closure is enumerated by test ReachableFocalSets.
+ */
+template <>
+struct PlaneLayout<FrameMG>
+{
+  static constexpr bool stored(Subset a)
+  {
+    return a != 0 && a != (FrameMG::kC | FrameMG::kV) && a != (FrameMG::kF | FrameMG::kC | FrameMG::kV);
+  }
+};
+
+/**
+ * @brief A grid of mass functions on @p Frame. Each stored subset a has a plane (slot(a)) holding m(a) for every
+ *        cell, row-major; the plane after the last slot holds the counter ζ (used by the MapGrid, zero elsewhere).
+ *        A subset that is not stored has mass 0 in every cell.
  */
 template <class Frame>
 class MassGrid
 {
+  static constexpr std::array<int, Frame::kNumSubsets> makeSlots()
+  {
+    std::array<int, Frame::kNumSubsets> t{};
+    int next = 0;
+    for (int a = 0; a < Frame::kNumSubsets; ++a) t[a] = PlaneLayout<Frame>::stored(static_cast<Subset>(a)) ? next++ : -1;
+    return t;
+  }
+
 public:
-  static constexpr int kNumPlanes = Frame::kNumSubsets;
+  /// slot(a) for every subset a, −1 where a is not stored.
+  static constexpr std::array<int, Frame::kNumSubsets> kSlots = makeSlots();
+  /// Number of mass planes (stored subsets); the counter ζ is one more plane.
+  static constexpr int kNumPlanes = [] {
+    int n = 0;
+    for (int a = 0; a < Frame::kNumSubsets; ++a) n += PlaneLayout<Frame>::stored(static_cast<Subset>(a));
+    return n;
+  }();
+  static constexpr bool stored(Subset a) { return PlaneLayout<Frame>::stored(a); }
+  /// The plane index of a stored subset.
+  static constexpr int slot(Subset a) { return kSlots[a]; }
 
   MassGrid() = default;
   /// A vacuous grid (m(Ω) = 1, ζ = 0) of the given geometry.
@@ -63,28 +108,46 @@ public:
   /// Distance in floats between two consecutive planes.
   std::size_t stride() const { return stride_; }
 
-  float* plane(Subset a) { return data_.data() + stride_ * a; }
-  const float* plane(Subset a) const { return data_.data() + stride_ * a; }
+  /// The plane of subset @p a. @throws std::out_of_range when @p a is not stored.
+  float* plane(Subset a) { return data_.data() + stride_ * checkedSlot(a); }
+  const float* plane(Subset a) const { return data_.data() + stride_ * checkedSlot(a); }
+  /// The first plane (slot 0); plane k is k · stride() floats further.
+  float* planes() { return data_.data(); }
+  const float* planes() const { return data_.data(); }
   float* counter() { return data_.data() + stride_ * kNumPlanes; }
   const float* counter() const { return data_.data() + stride_ * kNumPlanes; }
 
   /// The mass function of cell @p i, in double.
   MassFunction<Frame> cell(std::size_t i) const
   {
-    typename MassFunction<Frame>::Values v;
-    for (int a = 0; a < kNumPlanes; ++a) v[a] = plane(static_cast<Subset>(a))[i];
+    typename MassFunction<Frame>::Values v{};
+    for (int a = 0; a < Frame::kNumSubsets; ++a)
+      if (kSlots[a] >= 0) v[a] = data_[stride_ * kSlots[a] + i];
     return MassFunction<Frame>::fromValues(v);
   }
 
+  /// @throws std::invalid_argument when @p m has mass on a subset this grid does not store.
   void setCell(std::size_t i, const MassFunction<Frame>& m)
   {
-    for (int a = 0; a < kNumPlanes; ++a) plane(static_cast<Subset>(a))[i] = static_cast<float>(m[a]);
+    for (int a = 0; a < Frame::kNumSubsets; ++a)
+      if (kSlots[a] < 0 && m[a] != 0.0)
+        throw std::invalid_argument("MassGrid::setCell: mass on " + subsetName<Frame>(static_cast<Subset>(a)) +
+                                    ", a subset this grid does not store");
+    for (int a = 0; a < Frame::kNumSubsets; ++a)
+      if (kSlots[a] >= 0) data_[stride_ * kSlots[a] + i] = static_cast<float>(m[a]);
   }
 
   /// Bytes of cell storage (all planes and the counter).
   std::size_t bytes() const { return data_.size() * sizeof(float); }
 
 private:
+  static std::size_t checkedSlot(Subset a)
+  {
+    if (a >= Frame::kNumSubsets || kSlots[a] < 0)
+      throw std::out_of_range("MassGrid: subset " + std::to_string(a) + " has no plane");
+    return static_cast<std::size_t>(kSlots[a]);
+  }
+
   GridGeometry geometry_;
   std::size_t stride_ = 0;
   AlignedVector<float> data_;

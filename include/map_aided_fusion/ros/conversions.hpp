@@ -30,7 +30,7 @@ public:
 enum class PlaneSelection
 {
   kNonZero,  ///< only the focal sets with mass somewhere (compact; the others are zero by definition)
-  kAll       ///< every subset of the frame, ∅ included
+  kAll       ///< every subset the grid stores (all of a ScanGrid's, ∅ included; the MapGrid's 29, PlaneLayout)
 };
 
 /// Static converters; every function is pure and thread-safe.
@@ -50,7 +50,8 @@ public:
   /**
    * @brief EvidentialGrid → core grid. Layers not in the message are zero; the counter is read when present.
    * @throws ConversionError when the classes are not those of @p Frame, a focal set is out of range or
-   *         repeated, or the array sizes do not match info.width × info.height.
+   *         repeated, mass is on a subset @p grid does not store (PlaneLayout), or the array sizes do not match
+   *         info.width × info.height.
    */
   template <class Frame>
   static void fromMessage(const EvidentialGrid& msg, core::MassGrid<Frame>& grid);

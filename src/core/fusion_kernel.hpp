@@ -1,0 +1,67 @@
+// The fused per-cell loop of fusionStep(), in its own translation unit, which CMakeLists.txt compiles with
+// -fno-signed-zeros -ffinite-math-only (the planes the MapGrid never stores are compile-time zeros: their products
+// fold away; nothing is reassociated) and -fschedule-insns -fsched-pressure (register-pressure-aware scheduling).
+// Nothing in it validates input: NaN checks stay out of this unit.
+#pragma once
+
+#include <cstddef>
+
+#include "map_aided_fusion/core/discounting.hpp"
+#include "map_aided_fusion/core/fusion.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+namespace kernels {
+
+/// Everything the fused loop reads, hoisted out of it.
+struct StepInputs
+{
+  float* base;
+  float* zeta;
+  std::size_t stride;
+  std::size_t cells;
+  const float* sf;
+  const float* so;
+  const float* sw;
+  const float* pb;
+  const float* pr;
+  const float* pt;
+  const float* pw;
+  float delta_inc, delta_dec, gamma_occupied, gamma_conflict, threshold;
+  bool literal;
+  int rule;
+  bool contextual;
+  float alpha_single;
+  bool use_counter;
+  bool moving_expiry;
+  float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
+
+  /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved, the plane stride kept.
+  StepInputs offset(std::size_t begin, std::size_t count) const
+  {
+    StepInputs o = *this;
+    auto move = [begin](auto*& p) {
+      if (p) p += begin;
+    };
+    move(o.base);
+    move(o.zeta);
+    move(o.sf);
+    move(o.so);
+    move(o.sw);
+    move(o.pb);
+    move(o.pr);
+    move(o.pt);
+    move(o.pw);
+    for (auto*& b : o.betp) move(b);
+    o.cells = count;
+    return o;
+  }
+};
+
+/// The fused step on the cells of @p in (one chunk): masses, ζ and BetP in place, conflicts summed into @p out.
+void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w, bool has_prior, bool wall, bool paper,
+                 FusionStepStats& out);
+
+}  // namespace kernels
+}  // namespace core
+}  // namespace map_aided_fusion
