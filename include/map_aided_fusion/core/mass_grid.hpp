@@ -22,7 +22,7 @@ namespace core {
 /// Planes start on a cache line: their stride is a multiple of this many floats (64 bytes).
 constexpr std::size_t kPlaneAlignmentFloats = 16;
 /// Plane strides are a multiple of a page plus one cache line, so that the planes of one cell never
-/// share a cache set (a page-multiple stride makes 33 streams fight over the same sets).
+/// share a cache set (a page-multiple stride makes some 40 streams fight over the same sets).
 constexpr std::size_t kPlanePageFloats = 1024;
 
 /// Which subsets of @p Frame a MassGrid stores: every one, by default.
