@@ -24,10 +24,9 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     loadMasses(base, stride, i, m);
     T sp[kNumScanPrior];
     const T zero{};
-    scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i),
-                           kHasPrior ? load<T>(in.pb + i) : zero, kHasPrior ? load<T>(in.pr + i) : zero,
-                           kHasPrior ? load<T>(in.pt + i) : zero, kWall ? load<T>(in.pw + i) : zero, sp,
-                           in.threshold);
+    scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i), kHasPrior ? load<T>(in.pb + i) : zero,
+                  kHasPrior ? load<T>(in.pr + i) : zero, kHasPrior ? load<T>(in.pt + i) : zero,
+                  kWall ? load<T>(in.pw + i) : zero, sp, in.threshold);
     if (kPaper || in.contextual)
       contextualDiscount(m, weightsFor<T>(w, w8, lane));
     else
@@ -35,9 +34,8 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     const auto c = modifiedYager<kWall>(m, sp, kPaper ? kRuleModifiedYager : in.rule);
     if (kPaper || in.use_counter)
     {
-      const T z = updateCounter(load<T>(zeta + i), occupiedMass(m),
-                                         c.free_occupied + c.occupied_free, in.delta_inc, in.delta_dec,
-                                         in.gamma_occupied, in.gamma_conflict);
+      const T z = updateCounter(load<T>(zeta + i), occupiedMass(m), c.free_occupied + c.occupied_free, in.delta_inc,
+                                in.delta_dec, in.gamma_occupied, in.gamma_conflict);
       store(zeta + i, z);
       specialise(m, z, in.literal);
     }
@@ -61,9 +59,9 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
   stats.num_cells = in.cells;
 }
 
-/// One chunk of the step, compiled for each target of MAF_TARGET_CLONES (a lambda would get only the default one).
 }  // namespace
 
+// Compiled for each target of MAF_TARGET_CLONES (a lambda would get only the default one).
 MAF_TARGET_CLONES
 void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w, bool has_prior, bool wall, bool paper,
                  FusionStepStats& out)
@@ -75,7 +73,6 @@ void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w
   else
     paper ? fusionLoop<false, true, false>(in, w, out) : fusionLoop<false, false, false>(in, w, out);
 }
-
 
 }  // namespace kernels
 }  // namespace core

@@ -24,12 +24,10 @@ void refineGrid(const ScanMassGrid& scan, MapMassGrid& out)
 {
   if (out.geometry() != scan.geometry()) out.reset(scan.geometry());
   const std::size_t n = scan.numCells();
-  const float* __restrict e = scan.plane(FrameSG::kEmpty);
   const float* __restrict f = scan.plane(FrameSG::kF);
   const float* __restrict o = scan.plane(FrameSG::kO);
   const float* __restrict w = scan.plane(FrameSG::kOmega);
-  (void)e;  // m_SG(∅) has no plane in a MapGrid; the fusion never reads it
-  for (int a = 1; a < kSubsets; ++a)
+  for (int a = 1; a < kSubsets; ++a)  // m_SG(∅) has no plane in a MapGrid; the fusion never reads it
   {
     if (!MapMassGrid::stored(static_cast<Subset>(a))) continue;
     float* __restrict dst = out.plane(static_cast<Subset>(a));

@@ -218,12 +218,15 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
     const int ty = static_cast<int>(band) * kProjectTile;
     const int ty1 = std::min(h, ty + kProjectTile);
     int lo[kProjectTile], hi[kProjectTile];
+    double fxr[kProjectTile], fyr[kProjectTile];  // scan cell coordinates of each row's first cell
     for (int y = ty; y < ty1; ++y)
     {
-      row_interval(fx00 + y * drx, fy00 + y * dry, lo[y - ty], hi[y - ty]);
+      fxr[y - ty] = fx00 + y * drx;
+      fyr[y - ty] = fy00 + y * dry;
+      row_interval(fxr[y - ty], fyr[y - ty], lo[y - ty], hi[y - ty]);
       const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
       const int l = lo[y - ty], r = hi[y - ty];
-      for (const auto [b, e] : { std::pair{ 0, l }, std::pair{ r, w } })  // vacuous outside the scan grid
+      for (const auto& [b, e] : { std::pair{ 0, l }, std::pair{ r, w } })  // vacuous outside the scan grid
       {
         std::fill(df + row + b, df + row + e, 0.0f);
         std::fill(d_o + row + b, d_o + row + e, 0.0f);
@@ -233,13 +236,12 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
     for (int tx = 0; tx < w; tx += kProjectTile)
       for (int y = ty; y < ty1; ++y)
       {
-        const double fxr = fx00 + y * drx, fyr = fy00 + y * dry;
         const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
         const int x_end = std::min({ w, tx + kProjectTile, hi[y - ty] });
         const int x0 = std::max(tx, lo[y - ty]);
         if (x0 < x_end)
-          sampleRun(ScanPlanes{ sf, s_o, sw }, sg.width, fxr, fyr, dfx, dfy, x0, x_end, points, df + row, d_o + row,
-                    dw + row);
+          sampleRun(ScanPlanes{ sf, s_o, sw }, sg.width, fxr[y - ty], fyr[y - ty], dfx, dfy, x0, x_end, points,
+                    df + row, d_o + row, dw + row);
       }
   });
   if (points)

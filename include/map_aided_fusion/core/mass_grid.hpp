@@ -69,7 +69,7 @@ public:
   /// Number of mass planes (stored subsets); the counter ζ is one more plane.
   static constexpr int kNumPlanes = [] {
     int n = 0;
-    for (int a = 0; a < Frame::kNumSubsets; ++a) n += PlaneLayout<Frame>::stored(static_cast<Subset>(a));
+    for (const int s : kSlots) n += s >= 0;
     return n;
   }();
   static constexpr bool stored(Subset a) { return PlaneLayout<Frame>::stored(a); }
