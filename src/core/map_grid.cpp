@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/prior_uncertainty.hpp"
@@ -23,6 +24,9 @@ constexpr std::size_t kClearanceRows = 64;     // rows per chunk of the clearanc
 constexpr std::size_t kClearanceColumns = 256;  // columns per chunk of its column pass
 constexpr std::size_t kCellChunk = 16384;      // cells per chunk of the per-cell passes
 constexpr std::size_t kPriorRows = 32;         // rows per chunk of the prior window's copy
+constexpr std::size_t kMarkChunk = 32768;       // scan cells or returns per chunk of the occupancy marks
+constexpr std::size_t kSpreadChunk = 256;      // cells per chunk of motion spreading's cell pass
+constexpr std::size_t kSpreadAhead = 4;        // cells ahead whose planes that pass prefetches
 /// Bounds of memory_budget_mb, MiB.
 constexpr double kMinBudgetMb = 1.0;
 constexpr double kMaxBudgetMb = 1048576.0;
@@ -155,6 +159,17 @@ void sampleRun(ScanPlanes scan, int scan_width, double fxr, double fyr, double d
   }
 }
 
+/// The free mass of the cells [0, n) whose @p count is positive goes to Ω.
+void clearFree(const int* count, std::size_t n, float* __restrict f, float* __restrict omega)
+{
+  for (std::size_t x = 0; x < n; ++x)
+  {
+    const bool clear = count[x] > 0;
+    omega[x] = clear ? omega[x] + f[x] : omega[x];
+    f[x] = clear ? 0.0f : f[x];
+  }
+}
+
 }  // namespace
 
 void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)
@@ -166,7 +181,18 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
                  const ObstaclePoints* obstacles, int clearance_cells, const Parallel* parallel)
 {
   const Parallel& par = orSerial(parallel);
-  if (out.geometry() != window) out.reset(window);
+  const GridGeometry& had = out.geometry();
+  if (had != window && had.width == window.width && had.height == window.height &&
+      had.resolution == window.resolution && out.stride() > 0)
+  {
+    // The window moved: F, O and Ω are all written below, so only ∅ (which the forward pass may copy) is cleared.
+    out.setOrigin(window.origin_x, window.origin_y);
+    std::fill_n(out.plane(FrameSG::kEmpty), window.numCells(), 0.0f);
+  }
+  else if (had != window)
+  {
+    out.reset(window);
+  }
   const GridGeometry& sg = scan.geometry();
   // m(∅) of a ScanGrid is not used by the fusion: only F, O and Ω are mapped (∅ stays 0 in out).
   float* const df = out.plane(FrameSG::kF);
@@ -244,43 +270,67 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
                     df + row, d_o + row, dw + row);
       }
   });
-  if (points)
+  // Occupancy marks: the occupied cells (or returns) and the window cell under each are found by fixed chunks in
+  // parallel, then applied in index order, so ties resolve as in one serial pass whatever the thread count.
+  struct Mark
   {
-    // Point occupancy: each return marks the window cell under it with its scan cell's occupied mass.
-    for (std::size_t k = 0; k < obstacles->count; ++k)
+    std::size_t from, to;  // scan cell or return; window cell
+  };
+  const std::size_t sources = points ? obstacles->count : scan.numCells();
+  const std::size_t mark_chunks = chunkCount(sources, kMarkChunk);
+  thread_local std::vector<std::vector<Mark>> calling_thread_marks;
+  std::vector<std::vector<Mark>>& marks = calling_thread_marks;  // the workers fill the caller's lists
+  if (marks.size() < mark_chunks) marks.resize(mark_chunks);
+  auto window_cell = [&](double vx, double vy, std::size_t& j) {
+    CellIndex wc;
+    if (!window.worldToCell(Point2{ pose.x + c * vx - s * vy, pose.y + s * vx + c * vy }, wc)) return false;
+    j = window.index(wc);
+    return true;
+  };
+  par.forChunks(mark_chunks, [&](std::size_t chunk) {
+    std::vector<Mark>& out_marks = marks[chunk];
+    out_marks.clear();
+    std::size_t j = 0;
+    for (std::size_t k = chunk * kMarkChunk, end = std::min(sources, k + kMarkChunk); k < end; ++k)
     {
-      const double vx = obstacles->xy[2 * k], vy = obstacles->xy[2 * k + 1];
-      CellIndex sc, wc;
-      if (!sg.worldToCell(Point2{ vx, vy }, sc)) continue;
-      const float o = s_o[sg.index(sc)];
-      if (o <= 0.0f) continue;
-      if (!window.worldToCell(Point2{ pose.x + c * vx - s * vy, pose.y + s * vx + c * vy }, wc)) continue;
-      const std::size_t j = window.index(wc);
-      if (o > d_o[j])
+      if (points)
       {
-        df[j] = 0.0f;
-        d_o[j] = o;
-        dw[j] = 1.0f - o;
+        const double vx = obstacles->xy[2 * k], vy = obstacles->xy[2 * k + 1];
+        CellIndex sc;
+        if (!sg.worldToCell(Point2{ vx, vy }, sc)) continue;
+        const std::size_t i = sg.index(sc);
+        if (s_o[i] > 0.0f && window_cell(vx, vy, j)) out_marks.push_back(Mark{ i, j });
+      }
+      else if (s_o[k] > 0.0f)
+      {
+        const Point2 v = sg.cellCentre(sg.cellOf(k));
+        if (window_cell(v.x, v.y, j)) out_marks.push_back(Mark{ k, j });
       }
     }
-  }
-  else
-  {
-    // Forward pass: every occupied scan cell marks the window cell under its centre.
-    for (std::size_t i = 0; i < scan.numCells(); ++i)
+  });
+  for (std::size_t chunk = 0; chunk < mark_chunks; ++chunk)
+    for (const Mark& m : marks[chunk])
     {
-      if (s_o[i] <= 0.0f) continue;
-      const Point2 v = sg.cellCentre(sg.cellOf(i));
-      CellIndex wc;
-      if (!window.worldToCell(Point2{ pose.x + c * v.x - s * v.y, pose.y + s * v.x + c * v.y }, wc)) continue;
-      const std::size_t j = window.index(wc);
-      if (s_o[i] > d_o[j]) copyCell(scan, i, out, j);
+      const float o = s_o[m.from];
+      if (!(o > d_o[m.to])) continue;
+      if (points)
+      {
+        // Point occupancy: the window cell under the return takes its scan cell's occupied mass.
+        df[m.to] = 0.0f;
+        d_o[m.to] = o;
+        dw[m.to] = 1.0f - o;
+      }
+      else
+      {
+        // Forward pass: the window cell under an occupied scan cell's centre takes that cell.
+        copyCell(scan, m.from, out, m.to);
+      }
     }
-  }
   if (clearance_cells <= 0) return;
-  // Obstacle clearance: no free evidence within clearance_cells (square) of an occupied cell; a separable running
-  // count (along each row, then down each strip of columns), linear in the window whatever the number of occupied
-  // cells. Rows, then column strips, are independent chunks.
+  // Obstacle clearance: no free evidence within clearance_cells (square) of an occupied cell. Separable: a row pass
+  // marks the cells within k columns of an occupied cell (an OR of 2k + 1 shifted rows of bytes), then a running count
+  // down each strip of columns. Both vectorise, are linear in the window whatever the number of occupied cells, and
+  // rows, then column strips, are independent chunks.
   thread_local std::vector<std::uint8_t> rows;
   const std::size_t n = window.numCells();
   const std::size_t ws = static_cast<std::size_t>(w);
@@ -288,17 +338,17 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
   std::uint8_t* const near = rows.data();
   const int k = clearance_cells;
   par.forRange(static_cast<std::size_t>(h), kClearanceRows, [&](std::size_t y0, std::size_t y1) {
+    thread_local std::vector<std::uint8_t> occupied;
+    occupied.resize(ws);
+    std::uint8_t* const occ = occupied.data();
     for (std::size_t y = y0; y < y1; ++y)
     {
-      const std::size_t r = y * ws;
-      int count = 0;
-      for (int x = 0; x < std::min(w, k); ++x) count += d_o[r + x] > 0.0f;
-      for (int x = 0; x < w; ++x)
-      {
-        if (x + k < w) count += d_o[r + x + k] > 0.0f;
-        if (x - k - 1 >= 0) count -= d_o[r + x - k - 1] > 0.0f;
-        near[r + x] = count > 0;
-      }
+      const float* o = d_o + y * ws;
+      std::uint8_t* r = near + y * ws;
+      for (std::size_t x = 0; x < ws; ++x) occ[x] = o[x] > 0.0f;
+      std::fill(r, r + ws, std::uint8_t{ 0 });
+      for (int d = -k; d <= k; ++d)
+        for (int x = std::max(0, -d), x1 = std::min(w, w - d); x < x1; ++x) r[x] |= occ[x + d];
     }
   });
   par.forRange(ws, kClearanceColumns, [&](std::size_t x0, std::size_t x1) {
@@ -308,29 +358,58 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
       for (std::size_t x = 0; x < cw; ++x) column[x] += near[static_cast<std::size_t>(y) * ws + x0 + x];
     for (int y = 0; y < h; ++y)
     {
-      const std::uint8_t* add = y + k < h ? near + static_cast<std::size_t>(y + k) * ws + x0 : nullptr;
-      const std::uint8_t* sub = y - k - 1 >= 0 ? near + static_cast<std::size_t>(y - k - 1) * ws + x0 : nullptr;
-      float* f = df + static_cast<std::size_t>(y) * ws + x0;
-      float* u = dw + static_cast<std::size_t>(y) * ws + x0;
-      for (std::size_t x = 0; x < cw; ++x)
+      if (y + k < h)
       {
-        column[x] += (add ? add[x] : 0) - (sub ? sub[x] : 0);
-        if (column[x] > 0)
-        {
-          u[x] += f[x];
-          f[x] = 0.0f;
-        }
+        const std::uint8_t* add = near + static_cast<std::size_t>(y + k) * ws + x0;
+        for (std::size_t x = 0; x < cw; ++x) column[x] += add[x];
       }
+      if (y - k - 1 >= 0)
+      {
+        const std::uint8_t* sub = near + static_cast<std::size_t>(y - k - 1) * ws + x0;
+        for (std::size_t x = 0; x < cw; ++x) column[x] -= sub[x];
+      }
+      clearFree(column, cw, df + static_cast<std::size_t>(y) * ws + x0, dw + static_cast<std::size_t>(y) * ws + x0);
     }
   });
 }
 
-void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
-                        const Parallel* parallel)
+namespace {
+
+/// The step map_conflict on the cells [i0, i1) of @p prior (see applyMapConflict).
+void conflictCells(PriorWindow& prior, const float* __restrict sf, const float* __restrict so, float g,
+                   float* __restrict eta_out, std::size_t i0, std::size_t i1)
+{
+  float* __restrict b = prior.building.data();
+  float* __restrict r = prior.road.data();
+  float* __restrict t = prior.other.data();
+  float* __restrict wall = prior.wall.data();
+  for (std::size_t i = i0; i < i1; ++i)
+  {
+    const float k = b[i] * sf[i];
+    const float a = (b[i] + wall[i]) * so[i];
+    const float raw = eta_out[i] + g * (k - a);
+    const float low = raw < 0.0f ? 0.0f : raw;
+    const float eta = 1.0f < low ? 1.0f : low;  // std::clamp(raw, 0, 1), written so that it vectorises
+    eta_out[i] = eta;
+    const float keep = 1.0f - eta;
+    b[i] *= keep;
+    r[i] *= keep;
+    t[i] *= keep;
+    wall[i] *= keep;
+  }
+}
+
+void extractPriorRows(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
+                      const MapConflict* conflict, const Parallel* parallel)
 {
   const Parallel& par = orSerial(parallel);
   if (out.building.size() != window.numCells() || out.wall.size() != window.numCells())
     out.reset(window);
+  if (conflict && conflict->doubt->size() != window.numCells()) conflict->doubt->assign(window.numCells(), 0.0f);
+  const float* const csf = conflict ? conflict->scan->plane(FrameSG::kF) : nullptr;
+  const float* const cso = conflict ? conflict->scan->plane(FrameSG::kO) : nullptr;
+  float* const ceta = conflict ? conflict->doubt->data() : nullptr;
+  const float cgain = conflict ? static_cast<float>(conflict->gain) : 0.0f;
   out.geometry = window;
   std::vector<int> column(static_cast<std::size_t>(window.width));
   int first = -1, last = -1;  // window columns inside the prior
@@ -374,9 +453,58 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
         }
         for (std::size_t x = 0; x < ww; ++x) d[x] = column[x] < 0 ? 0.0f : s[column[x]];
       }
+      if (conflict) conflictCells(out, csf, cso, cgain, ceta, row, row + ww);
     }
   });
 }
+
+}  // namespace
+
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
+                        const Parallel* parallel)
+{
+  extractPriorRows(prior, window, out, nullptr, parallel);
+}
+
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
+                        const MapConflict& conflict, const Parallel* parallel)
+{
+  if (!conflict.scan || !conflict.doubt || conflict.scan->geometry().width != window.width ||
+      conflict.scan->geometry().height != window.height)
+    throw std::invalid_argument("extractPriorWindow: the map conflict needs a scan and a doubt of the window's size");
+  extractPriorRows(prior, window, out, &conflict, parallel);
+}
+
+namespace {
+
+/// decide() on the cells [i0, i1); the output (bytes may alias anything) is written through a restricted pointer
+/// so that the loop vectorises.
+void decideCells(const float* __restrict omega, const float* const* p, float t, std::int8_t* __restrict d,
+                 std::size_t i0, std::size_t i1)
+{
+  const float* __restrict p0 = p[0];
+  const float* __restrict p1 = p[1];
+  const float* __restrict p2 = p[2];
+  const float* __restrict p3 = p[3];
+  const float* __restrict p4 = p[4];
+  static_assert(FrameMG::kSize == 5, "one pointer per element of Ω");
+  for (std::size_t i = i0; i < i1; ++i)
+  {
+    const float q[FrameMG::kSize] = { p0[i], p1[i], p2[i], p3[i], p4[i] };
+    float best_p = q[0];
+    std::int8_t best = 0;
+    for (int e = 1; e < FrameMG::kSize; ++e)
+    {
+      const bool better = q[e] > best_p;
+      best_p = better ? q[e] : best_p;
+      best = better ? static_cast<std::int8_t>(e) : best;
+    }
+    const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
+    d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
+  }
+}
+
+}  // namespace
 
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out,
             const Parallel* parallel)
@@ -388,21 +516,8 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
   const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
   const float t = static_cast<float>(threshold);
   std::int8_t* const d = out.data();
-  par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
-    for (std::size_t i = i0; i < i1; ++i)
-    {
-      float best_p = p[0][i];
-      std::int8_t best = 0;
-      for (int e = 1; e < FrameMG::kSize; ++e)
-      {
-        const bool better = p[e][i] > best_p;
-        best_p = better ? p[e][i] : best_p;
-        best = better ? static_cast<std::int8_t>(e) : best;
-      }
-      const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
-      d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
-    }
-  });
+  par.forRange(n, kCellChunk,
+               [&](std::size_t i0, std::size_t i1) { decideCells(omega, p, t, d, i0, i1); });
 }
 
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
@@ -450,10 +565,8 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
       if (so[i] > 0.0f && is_moving(i)) seeds[c].push_back(i);
   });
   std::vector<std::uint8_t> seen(n, 0);
-  std::vector<std::size_t> stack, region;
+  std::vector<std::size_t> stack, region, cells;
   std::size_t spread = 0;
-  float* const base = grid.planes();
-  const std::size_t stride = grid.stride();
   for (const std::vector<std::size_t>& chunk : seeds)
     for (const std::size_t start : chunk)
     {
@@ -465,23 +578,37 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
           static_cast<double>(moving) < share * static_cast<double>(region.size()))
         continue;
       ++spread;
-      for (const std::size_t i : region)
-      {
-        float mass[kernels::kSubsets];
-        kernels::loadMasses(base, stride, i, mass);
-        for (int a = 0; a < kernels::kSubsets; ++a)
-          if ((a & FrameMG::kV) && a != FrameMG::kV && !(a & FrameMG::kF))
-          {
-            mass[FrameMG::kV] += mass[a];
-            mass[a] = 0.0f;
-          }
-        kernels::renormalise(mass);
-        kernels::storeMasses(base, stride, i, mass);
-        float p[FrameMG::kSize];
-        kernels::pignistic(mass, p);
-        for (int e = 0; e < FrameMG::kSize; ++e) betp.p[e][i] = p[e];
-      }
+      cells.insert(cells.end(), region.begin(), region.end());
     }
+  // The regions are disjoint and each cell's new masses depend on that cell alone: fixed chunks of the cells in
+  // parallel, each cell's planes asked for a few cells ahead (they are scattered over the window).
+  float* const base = grid.planes();
+  const std::size_t stride = grid.stride();
+  orSerial(parallel).forRange(cells.size(), kSpreadChunk, [&](std::size_t k0, std::size_t k1) {
+    for (std::size_t k = k0; k < k1; ++k)
+    {
+      if (k + kSpreadAhead < k1)
+      {
+        const std::size_t ahead = cells[k + kSpreadAhead];
+        for (int slot = 0; slot < MapMassGrid::kNumPlanes; ++slot) __builtin_prefetch(base + slot * stride + ahead, 1);
+        for (int e = 0; e < FrameMG::kSize; ++e) __builtin_prefetch(betp.p[e].data() + ahead, 1);
+      }
+      const std::size_t i = cells[k];
+      float mass[kernels::kSubsets];
+      kernels::loadMasses(base, stride, i, mass);
+      for (int a = 0; a < kernels::kSubsets; ++a)
+        if ((a & FrameMG::kV) && a != FrameMG::kV && !(a & FrameMG::kF))
+        {
+          mass[FrameMG::kV] += mass[a];
+          mass[a] = 0.0f;
+        }
+      kernels::renormalise(mass);
+      kernels::storeMasses(base, stride, i, mass);
+      float p[FrameMG::kSize];
+      kernels::pignistic(mass, p);
+      for (int e = 0; e < FrameMG::kSize; ++e) betp.p[e][i] = p[e];
+    }
+  });
   return spread;
 }
 
@@ -650,20 +777,8 @@ void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain,
   const float* sf = scan.plane(FrameSG::kF);
   const float* so = scan.plane(FrameSG::kO);
   float* const eta_out = doubt.data();
-  par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
-    for (std::size_t i = i0; i < i1; ++i)
-    {
-      const float k = prior.building[i] * sf[i];
-      const float a = (prior.building[i] + prior.wall[i]) * so[i];
-      const float eta = std::clamp(eta_out[i] + g * (k - a), 0.0f, 1.0f);
-      eta_out[i] = eta;
-      const float keep = 1.0f - eta;
-      prior.building[i] *= keep;
-      prior.road[i] *= keep;
-      prior.other[i] *= keep;
-      prior.wall[i] *= keep;
-    }
-  });
+  par.forRange(n, kCellChunk,
+               [&](std::size_t i0, std::size_t i1) { conflictCells(prior, sf, so, g, eta_out, i0, i1); });
 }
 
 void MapGrid::recentre(Point2 p)
@@ -704,9 +819,11 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   t0 = std::chrono::steady_clock::now();
   if (prior)
   {
-    extractPriorWindow(*prior, grid_.geometry(), prior_window_, parallel_.get());
     if (params_.map_conflict_gain > 0.0)
-      applyMapConflict(prior_window_, scan_window_, params_.map_conflict_gain, map_doubt_, parallel_.get());
+      extractPriorWindow(*prior, grid_.geometry(), prior_window_,
+                         MapConflict{ &scan_window_, params_.map_conflict_gain, &map_doubt_ }, parallel_.get());
+    else
+      extractPriorWindow(*prior, grid_.geometry(), prior_window_, parallel_.get());
   }
   t.prior_window = secondsSince(t0);
 

@@ -100,11 +100,12 @@ void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msg
     if (planes == PlaneSelection::kAll || std::any_of(p, p + n, [](float v) { return v != 0.0f; }))
       msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
   }
-  msg.masses.resize(msg.focal_sets.size() * n);
-  for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
+  msg.masses.clear();  // appended plane by plane: no zero fill first
+  msg.masses.reserve(msg.focal_sets.size() * n);
+  for (const std::uint8_t a : msg.focal_sets)
   {
-    const float* p = grid.plane(msg.focal_sets[k]);
-    std::copy(p, p + n, msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n));
+    const float* p = grid.plane(a);
+    msg.masses.insert(msg.masses.end(), p, p + n);
   }
   if (with_counter)
     msg.counter.assign(grid.counter(), grid.counter() + n);
@@ -137,8 +138,9 @@ void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Fram
   }
   if (grid.geometry() != g)
     grid.reset(g);
-  for (int a = 0; a < Frame::kNumSubsets; ++a)
-    if (grid.stored(static_cast<Subset>(a))) std::fill_n(grid.plane(static_cast<Subset>(a)), n, 0.0f);
+  for (int a = 0; a < Frame::kNumSubsets; ++a)  // each stored plane written once: copied, or zeros when absent
+    if (grid.stored(static_cast<Subset>(a)) && !(seen & (1ull << a)))
+      std::fill_n(grid.plane(static_cast<Subset>(a)), n, 0.0f);
   for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
     if (grid.stored(msg.focal_sets[k]))
       std::copy_n(msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n), n, grid.plane(msg.focal_sets[k]));

@@ -347,7 +347,8 @@ void FusionWorker::checkClock()
 void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
 {
   const auto wall0 = std::chrono::steady_clock::now();
-  core::ScanMassGrid scan;
+  // Reused from scan to scan (one per callback thread): no 10 MB allocation, page faults and zeroing per scan.
+  thread_local core::ScanMassGrid scan;
   try
   {
     GridConversions::fromMessage(*msg, scan);

@@ -1,7 +1,10 @@
 // The MapGrid on scripted scenes, without ROS.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 
@@ -164,10 +167,11 @@ TEST(ProjectScan, RotatedWindowSamplesTheScanCellUnderEachCellCentre)
     scan.setCell(i, MassSG{ { FrameSG::kF, f }, { FrameSG::kOmega, 1.0 - f } });
   }
   std::uniform_real_distribution<double> yaw(-M_PI, M_PI), shift(-6.0, 6.0);
-  const auto window = GridGeometry::centred(30.0, 24.0, kRes);
   ScanMassGrid out;  // reused: every cell of every trial must be written again
   for (int trial = 0; trial < 6; ++trial)
   {
+    // The window follows the vehicle by whole cells (its origin changes, its size does not), as in MapGrid::update.
+    const auto window = GridGeometry::centred(30.0, 24.0, kRes, (trial % 3) * 3 * kRes, -(trial % 2) * 5 * kRes);
     const Pose2 pose{ shift(rng), shift(rng), yaw(rng) };
     projectScan(scan, pose, window, out);
     std::size_t sampled = 0, mismatches = 0;
@@ -226,6 +230,100 @@ TEST(ProjectScan, IdentityIsAnExactCopyAndRotationLosesNoObstacle)
     for (std::size_t i = 0; i < out.numCells(); ++i) occupied += out.plane(FrameSG::kO)[i] > 0.0f;
     EXPECT_GE(occupied, 1) << "yaw " << yaw;
   }
+}
+
+TEST(ProjectScan, ClearanceTakesTheFreeMassWithinTheSquareOfEveryObstacle)
+{
+  // Sparse obstacles over free space, with and without point occupancy, at several clearances: each window cell within
+  // k cells (square, Chebyshev) of a cell with occupied mass has its free mass moved to Ω, every other cell is the
+  // projection without clearance, bit for bit.
+  const auto sg = GridGeometry::centred(30.0, 26.0, kRes);
+  ScanMassGrid scan(sg);
+  std::mt19937 rng(21);
+  std::uniform_int_distribution<int> kind(0, 99);
+  std::uniform_real_distribution<double> u(0.05, 0.9);
+  std::vector<float> xy;
+  for (std::size_t i = 0; i < scan.numCells(); ++i)
+  {
+    const double m = u(rng);
+    const bool obstacle = kind(rng) < 2;
+    scan.setCell(i, obstacle ? MassSG{ { FrameSG::kO, m }, { FrameSG::kOmega, 1.0 - m } }
+                             : MassSG{ { FrameSG::kF, m }, { FrameSG::kOmega, 1.0 - m } });
+    if (obstacle)
+    {
+      const Point2 c = sg.cellCentre(sg.cellOf(i));
+      xy.push_back(static_cast<float>(c.x));
+      xy.push_back(static_cast<float>(c.y));
+    }
+  }
+  const ObstaclePoints points{ xy.data(), xy.size() / 2 };
+  const auto window = GridGeometry::centred(36.0, 28.0, kRes);
+  ScanMassGrid plain, cleared;
+  for (const ObstaclePoints* obstacles : { static_cast<const ObstaclePoints*>(nullptr), &points })
+    for (int k : { 1, 3, 7 })
+      for (double yaw : { 0.0, 0.6, -2.3 })
+      {
+        const Pose2 pose{ 1.1, -0.4, yaw };
+        projectScan(scan, pose, window, plain, obstacles, 0);
+        projectScan(scan, pose, window, cleared, obstacles, k);
+        std::size_t near_obstacle = 0, mismatches = 0;
+        for (int y = 0; y < window.height; ++y)
+          for (int x = 0; x < window.width; ++x)
+          {
+            bool near = false;
+            for (int yy = std::max(0, y - k); yy <= std::min(window.height - 1, y + k) && !near; ++yy)
+              for (int xx = std::max(0, x - k); xx <= std::min(window.width - 1, x + k) && !near; ++xx)
+                near = plain.plane(FrameSG::kO)[window.index(xx, yy)] > 0.0f;
+            const std::size_t j = window.index(x, y);
+            const float f = plain.plane(FrameSG::kF)[j], w = plain.plane(FrameSG::kOmega)[j];
+            near_obstacle += near && f > 0.0f;
+            mismatches += cleared.plane(FrameSG::kF)[j] != (near ? 0.0f : f) ||
+                          cleared.plane(FrameSG::kOmega)[j] != (near ? w + f : w) ||
+                          cleared.plane(FrameSG::kO)[j] != plain.plane(FrameSG::kO)[j];
+          }
+        EXPECT_GT(near_obstacle, 50u) << "k " << k << " yaw " << yaw;
+        EXPECT_EQ(mismatches, 0u) << "k " << k << " yaw " << yaw << (obstacles ? " with points" : "");
+      }
+}
+
+TEST(ExtractPriorWindow, MapConflictInTheSamePassEqualsTheTwoSteps)
+{
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 0.9f);
+  PriorWindow prior(GridGeometry::centred(30.0, 30.0, kRes));
+  for (std::size_t i = 0; i < prior.building.size(); ++i)
+  {
+    prior.building[i] = u(rng) * 0.3f;
+    prior.road[i] = u(rng) * 0.3f;
+    prior.wall[i] = u(rng) * 0.3f;
+    prior.other[i] = u(rng) * 0.1f;
+  }
+  // Aligned and half outside; not aligned (a third of a cell off): each cell sampled.
+  for (const GridGeometry& window : { GridGeometry::centred(20.0, 16.0, kRes, 12.0, -3.0),
+                                      GridGeometry::centred(20.0, 16.0, kRes, 2.0 + kRes / 3.0, 1.0) })
+  {
+    ScanMassGrid scan(window);
+    for (std::size_t i = 0; i < scan.numCells(); ++i) scan.setCell(i, maf_test::randomMass<FrameSG>(rng, 3));
+    AlignedVector<float> doubt_two(window.numCells(), 0.1f), doubt_one = doubt_two;
+    PriorWindow two, one;
+    for (int step = 0; step < 3; ++step)  // η accumulates
+    {
+      extractPriorWindow(prior, window, two);
+      applyMapConflict(two, scan, 0.3, doubt_two);
+      extractPriorWindow(prior, window, one, MapConflict{ &scan, 0.3, &doubt_one });
+    }
+    float largest = 0.0f;
+    for (float e : doubt_one) largest = std::max(largest, e);
+    EXPECT_GT(largest, 0.1f) << "the scan must raise the doubt somewhere";
+    EXPECT_EQ(std::memcmp(doubt_one.data(), doubt_two.data(), doubt_one.size() * sizeof(float)), 0);
+    for (auto plane : { &PriorWindow::building, &PriorWindow::road, &PriorWindow::other, &PriorWindow::wall })
+      EXPECT_EQ(std::memcmp((one.*plane).data(), (two.*plane).data(), (one.*plane).size() * sizeof(float)), 0);
+  }
+  PriorWindow out;
+  AlignedVector<float> doubt;
+  ScanMassGrid small(GridGeometry::centred(4.0, 4.0, kRes));
+  const MapConflict mismatched{ &small, 0.2, &doubt };  // a scan of another size than the window
+  EXPECT_THROW(extractPriorWindow(prior, GridGeometry::centred(8.0, 8.0, kRes), out, mismatched), std::invalid_argument);
 }
 
 TEST(ExtractPriorWindow, CopiesAlignedCellsAndIsVacuousOutside)

@@ -200,6 +200,21 @@ void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const Gr
 void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
                         const Parallel* parallel = nullptr);
 
+/// The step map_conflict's inputs (see applyMapConflict), for extractPriorWindow to apply it row by row.
+struct MapConflict
+{
+  const ScanMassGrid* scan = nullptr;       ///< the scan in the window's cells
+  double gain = 0.0;                        ///< MapGridParams::map_conflict_gain
+  AlignedVector<float>* doubt = nullptr;    ///< η per window cell, updated
+};
+
+/**
+ * @brief extractPriorWindow() then applyMapConflict() with @p conflict, in one pass: each row is discounted while
+ *        it is still in cache. The result is identical to the two calls.
+ */
+void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
+                        const MapConflict& conflict, const Parallel* parallel = nullptr);
+
 /**
  * @brief The navigable-space layer (nav_msgs/OccupancyGrid values) from a decision grid and the prior of the same
  *        cells: free on the road surface (m_PG(R) above m_PG(T) + m_PG(B) + m_PG(W)) → 0; free elsewhere or where
