@@ -63,7 +63,6 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   return r;
 }
 
-
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
                 FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel)
 {

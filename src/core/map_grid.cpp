@@ -558,17 +558,28 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
   auto is_moving = [&](std::size_t i) { return pv[i] >= t && pv[i] - ps[i] > m; };
   // A region without a moving cell is left alone: only the occupied moving cells seed one. They are found by fixed
   // chunks in parallel and taken in index order, so the regions (disjoint) are the same for any thread count.
+  // The calling thread's buffers, kept from scan to scan (no allocation per scan). References to them are what the
+  // lambdas capture: a thread_local named inside a lambda would be the worker's own.
+  thread_local std::vector<std::vector<std::size_t>> calling_thread_seeds;
+  thread_local std::vector<std::uint8_t> calling_thread_seen;
+  thread_local std::vector<std::size_t> calling_thread_stack, calling_thread_region, calling_thread_cells;
+  std::vector<std::vector<std::size_t>>& seeds = calling_thread_seeds;
+  std::vector<std::uint8_t>& seen = calling_thread_seen;
+  std::vector<std::size_t>& stack = calling_thread_stack;
+  std::vector<std::size_t>& region = calling_thread_region;
+  std::vector<std::size_t>& cells = calling_thread_cells;
   const std::size_t chunks = chunkCount(n, kCellChunk);
-  std::vector<std::vector<std::size_t>> seeds(chunks);
+  if (seeds.size() < chunks) seeds.resize(chunks);
   orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
+    seeds[c].clear();
     for (std::size_t i = c * kCellChunk, end = std::min(n, i + kCellChunk); i < end; ++i)
       if (so[i] > 0.0f && is_moving(i)) seeds[c].push_back(i);
   });
-  std::vector<std::uint8_t> seen(n, 0);
-  std::vector<std::size_t> stack, region, cells;
+  seen.assign(n, 0);
+  cells.clear();
   std::size_t spread = 0;
-  for (const std::vector<std::size_t>& chunk : seeds)
-    for (const std::size_t start : chunk)
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (const std::size_t start : seeds[c])
     {
       if (seen[start]) continue;
       growRegion(g, start, [so](std::size_t j) { return so[j] > 0.0f; }, seen, stack, region);
@@ -744,7 +755,8 @@ void MapGrid::shift(int dx, int dy)
   constexpr int kPlanes = MapMassGrid::kNumPlanes;
   parallel_->forChunks(kPlanes + 1 + (doubt ? 1 : 0), [&](std::size_t c) {
     const int plane = static_cast<int>(c);
-    float* p = plane == kPlanes + 1 ? map_doubt_.data() : grid_.planes() + static_cast<std::size_t>(plane) * grid_.stride();
+    float* p = plane == kPlanes + 1 ? map_doubt_.data()
+                                    : grid_.planes() + static_cast<std::size_t>(plane) * grid_.stride();
     shiftPlane(p, g, dx, dy, plane == MapMassGrid::slot(FrameMG::kOmega) ? 1.0f : 0.0f);
   });
 }

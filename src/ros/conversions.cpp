@@ -132,7 +132,8 @@ void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Fram
   for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
   {
     const auto first = msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n);
-    if (!grid.stored(msg.focal_sets[k]) && std::any_of(first, first + static_cast<std::ptrdiff_t>(n), [](float v) { return v != 0.0f; }))
+    const auto nonzero = [](float v) { return v != 0.0f; };
+    if (!grid.stored(msg.focal_sets[k]) && std::any_of(first, first + static_cast<std::ptrdiff_t>(n), nonzero))
       throw ConversionError("EvidentialGrid: mass on focal set " + core::subsetName<Frame>(msg.focal_sets[k]) +
                             ", which this grid never holds");
   }

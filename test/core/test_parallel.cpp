@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "map_aided_fusion/core/fusion.hpp"
+#include "map_aided_fusion/core/grid_ops.hpp"
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/parallel.hpp"
 #include "map_aided_fusion/core/prior.hpp"
@@ -165,6 +166,46 @@ TEST(Parallel, MapGridDriveIsBitIdenticalForAnyThreadCount)
     EXPECT_TRUE(sameBytes(one.doubt, other.doubt)) << threads;
     EXPECT_TRUE(sameBytes(one.decision, other.decision)) << threads;
     EXPECT_TRUE(sameBytes(one.conflicts, other.conflicts)) << threads;
+  }
+}
+
+TEST(Parallel, MotionSpreadingOverManyChunksIsBitIdenticalForAnyThreadCount)
+{
+  // 1600 separate 4-cell objects (one V cell, three open {C, N, S, V}): 6400 cells to spread, many chunks of the
+  // spreading's cell pass, on the workers too.
+  const GridGeometry geo{ 0.5, 200, 120, 0.0, 0.0 };
+  MapMassGrid start(geo);
+  ScanMassGrid scan(geo);
+  std::size_t objects = 0;
+  for (int y = 0; y < geo.height; y += 3)
+    for (int x = 0; x + 4 <= geo.width; x += 5, ++objects)
+      for (int k = 0; k < 4; ++k)
+      {
+        const std::size_t i = geo.index(x + k, y);
+        start.plane(k == 0 ? FrameMG::kV : FrameMG::kO)[i] = 0.8f;
+        start.plane(FrameMG::kOmega)[i] = 0.2f;
+        scan.plane(FrameSG::kO)[i] = 0.8f;
+        scan.plane(FrameSG::kOmega)[i] = 0.2f;
+      }
+  std::vector<float> first_planes, first_betp;
+  for (int threads : { 1, 2, 4 })
+  {
+    const Parallel parallel(threads);
+    MapMassGrid g = start;
+    PignisticPlanes betp;
+    pignisticGrid(g, betp);
+    EXPECT_EQ(spreadMotion(g, betp, scan, 0.2, 200, 0.4, 0.1, &parallel), objects) << threads;
+    EXPECT_FLOAT_EQ(g.plane(FrameMG::kV)[geo.index(3, 0)], 0.8f) << "an open cell became V, " << threads;
+    std::vector<float> planes(g.planes(), g.planes() + g.stride() * MapMassGrid::kNumPlanes), p;
+    for (int e = 0; e < FrameMG::kSize; ++e) p.insert(p.end(), betp[e].begin(), betp[e].end());
+    if (threads == 1)
+    {
+      first_planes = planes;
+      first_betp = p;
+      continue;
+    }
+    EXPECT_TRUE(sameBytes(planes, first_planes)) << threads << " threads: masses differ";
+    EXPECT_TRUE(sameBytes(p, first_betp)) << threads << " threads: BetP differs";
   }
 }
 
