@@ -91,7 +91,8 @@ ScanGridParams spinningParams()
   return p;
 }
 
-/// The 64-beam street cloud of @p state.range(0) points into the 160 m grid with @p ground_model.
+/// The 64-beam street cloud of @p state.range(0) points into the 160 m grid with @p ground_model, on
+/// state.range(1) threads (ScanGridParams::threads).
 void scanGrid(benchmark::State& state, const char* ground_model)
 {
   const std::size_t n = static_cast<std::size_t>(state.range(0));
@@ -99,6 +100,7 @@ void scanGrid(benchmark::State& state, const char* ground_model)
   const auto cloud = makeCloud(n, 64, -25.0, 15.0, -kPi, 2.0 * kPi, h);
   ScanGridParams p = spinningParams();
   p.ground_model = ground_model;
+  p.threads = static_cast<int>(state.range(1));
   ScanGridBuilder builder(p, sensorAt(0.9, h));
   ScanMassGrid grid(builder.geometry());
   ScanGridStats st;
@@ -116,10 +118,12 @@ void scanGrid(benchmark::State& state, const char* ground_model)
 }
 
 void BM_ScanGrid(benchmark::State& state) { scanGrid(state, "flat"); }
-BENCHMARK(BM_ScanGrid)->Arg(0)->Arg(130000)->Arg(260000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ScanGrid)->ArgsProduct({ { 0, 130000, 260000 }, { 1, 2 } })->ArgNames({ "points", "threads" })
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_ScanGridGround(benchmark::State& state) { scanGrid(state, "planes"); }
-BENCHMARK(BM_ScanGridGround)->Arg(130000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ScanGridGround)->ArgsProduct({ { 130000 }, { 1, 2 } })->ArgNames({ "points", "threads" })
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_Deskew(benchmark::State& state)
 {

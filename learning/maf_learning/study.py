@@ -182,7 +182,8 @@ def _objective(setup, reference):
         values = {p.key: p.suggest(trial) for p in params}
         config_dir = os.path.join(setup.work, "trials", f"{trial.number:05d}")
         by_file = sp.split_values(values)
-        by_file.setdefault("fusion.yaml", {}).setdefault("threads", 1)  # one worker per core already
+        for name in ("fusion.yaml", "scan_grid.yaml"):
+            by_file.setdefault(name, {}).setdefault("threads", 1)  # one worker per core already
         sp.write_config_dir(config_dir, by_file, setup.config)
         metrics = []
         try:

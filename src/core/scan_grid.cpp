@@ -31,6 +31,12 @@ constexpr float kPi = 3.14159265358979323846f;
 constexpr float kHalfPi = 0.5f * kPi;
 constexpr float kTwoPi = 2.0f * kPi;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+/// Points (or valid returns) per chunk of build()'s point passes.
+constexpr std::size_t kPointChunk = 16384;
+/// Azimuth sectors per chunk of the free-space fill.
+constexpr std::size_t kSectorChunk = 64;
+/// Cells per chunk of the plane fills.
+constexpr std::size_t kFillChunk = 65536;
 
 // Minimax polynomial for atan(a), a in [0, 1]; absolute error below 1e-5 rad.
 constexpr float kAtan1 = 0.99997726f;
@@ -72,12 +78,111 @@ inline int sectorIndex(float dx, float dy, float scale, int num_sectors)
   return s >= num_sectors ? s - num_sectors : (s < 0 ? 0 : s);
 }
 
+/// Moves @p count records of @p width values from index @p from to index @p to ≤ from (the chunks' lists together).
+template <typename T>
+void moveSegment(T* data, std::size_t width, std::size_t from, std::size_t count, std::size_t to)
+{
+  if (from != to && count > 0) std::memmove(data + to * width, data + from * width, count * width * sizeof(T));
+}
+
+/// *p = min(*p, v), for threads sharing p: the result is that of any order.
+void atomicMin(float* p, float v)
+{
+  float current;
+  __atomic_load(p, &current, __ATOMIC_RELAXED);
+  while (v < current)
+    if (__atomic_compare_exchange(p, &current, &v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) return;
+}
+
 inline float readFloat(const std::uint8_t* p)
 {
   float v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
+
+constexpr std::uint32_t kOutside = std::numeric_limits<std::uint32_t>::max();  // an obstacle return off the grid
+
+/// What the point passes of ScanGridBuilder::build() read (the sensor model and the grid, as values) and where they
+/// write. Each chunk works on its own copy.
+struct PointPass
+{
+  float rot[9];  // sensor → base_link rotation, row-major
+  float shift_x, shift_y, trans_z, min2, max2, inv_res, cx0, cy0, fwidth, fheight, sector_scale;
+  float self_min_x, self_max_x, self_min_y, self_max_y, tolerance, obstacle_min, obstacle_max, relative_limit;
+  int width, num_sectors;
+  bool relative, shared;
+  std::uint32_t* ground_sector;
+  float* ground_range2;
+  std::uint32_t* obstacle_sector;
+  float* obstacle_range2;
+  std::uint32_t* obstacle_cell;
+  float* obstacle_xy;
+  float* obstacle_z;
+  float* cell_min_z;
+  // The cloud, and the valid returns of the `planes` ground model.
+  const std::uint8_t* data;
+  std::size_t cols, point_step, row_step, x_offset, y_offset, z_offset;
+  float ground;  // flat ground height
+  bool planes;
+  float* valid_dx;
+  float* valid_dy;
+  float* valid_z;
+  std::uint16_t* valid_zone;
+  const GroundPlaneFitter* fitter;
+
+  /// Classifies a valid return at (dx, dy) from the sensor, height z, over ground height g, into @p out.
+  template <class Out>
+  void classify(float dx, float dy, float z, float r2, float g, Out& out) const
+  {
+    if (relative)
+    {
+      const float fx = cx0 + dx * inv_res;
+      const float fy = cy0 + dy * inv_res;
+      if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
+      {
+        float* const lowest = cell_min_z + static_cast<int>(fy) * width + static_cast<int>(fx);
+        if (shared)  // chunks on other threads may lower the same cell's lowest return
+          atomicMin(lowest, z);
+        else
+          *lowest = std::min(*lowest, z);
+      }
+    }
+    const float h = z - g;
+    if (h < -tolerance)
+    {
+      ++out.counts.below_ground;
+    }
+    else if (h <= tolerance)
+    {
+      const std::size_t k = out.first + out.ground++;
+      ground_sector[k] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+      ground_range2[k] = r2;
+    }
+    else if (h < obstacle_min)
+    {
+      ++out.counts.gap;
+    }
+    else if (h <= obstacle_max)
+    {
+      const float fx = cx0 + dx * inv_res;
+      const float fy = cy0 + dy * inv_res;
+      const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
+      const std::size_t k = out.first + out.obstacle++;
+      obstacle_sector[k] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+      obstacle_range2[k] = r2;
+      obstacle_cell[k] =
+          inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
+      obstacle_xy[2 * k] = dx;
+      obstacle_xy[2 * k + 1] = dy;
+      if (relative) obstacle_z[k] = h < relative_limit ? z : kInfinity;
+    }
+    else
+    {
+      ++out.counts.above;
+    }
+  }
+};
 
 }  // namespace
 
@@ -108,6 +213,7 @@ void ScanGridParams::validate() const
   requireInRange("free_decay_length", free_decay_length, 0.0, kMaxExtent);
   requireInRange("free_margin", free_margin, 0.0, max_range);
   requireInRange("relative_height_limit", relative_height_limit, 0.0, kMaxExtent);
+  validateThreads("threads", threads);
   if (!(deskew_max_sweep_duration > 0.0)) throw ParameterError("deskew_max_sweep_duration", "must be > 0");
   requireInRange("deskew_max_sweep_duration", deskew_max_sweep_duration, 0.0, kMaxSweepDuration);
   groundModel();
@@ -178,6 +284,8 @@ void ScanGridBuilder::configure(const ScanGridParams& params, const Eigen::Isome
   configured_ = true;
   ground_kind_ = params.groundModel();
   ground_.configure(params.groundModelParams());
+  if (!parallel_ || parallel_->threads() != resolveThreads(params.threads))
+    parallel_ = std::make_shared<const Parallel>(params.threads);
   if (!same_table) buildTable();
 }
 
@@ -259,105 +367,65 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   if (relative)
   {
     if (obstacle_z_.size() < n_points + 1) obstacle_z_.resize(n_points + 1);
-    cell_min_z_.assign(geometry_.numCells(), kInfinity);
+    cell_min_z_.resize(geometry_.numCells());
+    float* const lowest = cell_min_z_.data();
+    parallel_->forRange(cell_min_z_.size(), kFillChunk,
+                        [lowest](std::size_t i0, std::size_t i1) { std::fill(lowest + i0, lowest + i1, kInfinity); });
   }
-  float* const obstacle_z = obstacle_z_.data();
-  float* const cell_min_z = cell_min_z_.data();
-  float* const obstacle_xy = obstacle_points_.data();
-
-  const Eigen::Matrix3f rot = sensor_pose_.rotation().cast<float>();
-  // Points relative to the table's sensor position (within kSensorMoveTolerance of the current one).
-  const float shift_x = static_cast<float>(sensor_pose_.translation().x() - table_sensor_x_);
-  const float shift_y = static_cast<float>(sensor_pose_.translation().y() - table_sensor_y_);
-  const float trans_z = static_cast<float>(sensor_pose_.translation().z());
-  const float ground = static_cast<float>(params_.ground_height);
-  const float min2 = static_cast<float>(params_.min_range * params_.min_range);
-  const float max2 = static_cast<float>(params_.max_range * params_.max_range);
-  const float inv_res = static_cast<float>(1.0 / geometry_.resolution);
-  // Cell coordinates of a point relative to the sensor: (d + sensor − origin) / resolution.
-  const float cx0 = static_cast<float>((table_sensor_x_ - geometry_.origin_x) / geometry_.resolution);
-  const float cy0 = static_cast<float>((table_sensor_y_ - geometry_.origin_y) / geometry_.resolution);
-  const int width = geometry_.width;
-  const float fwidth = static_cast<float>(geometry_.width);
-  const float fheight = static_cast<float>(geometry_.height);
-  constexpr std::uint32_t kOutside = std::numeric_limits<std::uint32_t>::max();
-  const float sector_scale = sector_scale_;
-  const int num_sectors = num_sectors_;
-  std::uint32_t* const ground_sector = ground_sector_.data();
-  float* const ground_range2 = ground_range2_.data();
-  std::uint32_t* const obstacle_sector = obstacle_sector_.data();
-  float* const obstacle_range2 = obstacle_range2_.data();
-  std::uint32_t* const obstacle_cell = obstacle_cell_.data();
-  const std::uint8_t* const data = points.data;
-  const std::size_t rows = points.height, cols = points.width, point_step = points.point_step;
-  const std::size_t row_step = points.row_step;
-  const std::size_t x_offset = points.x_offset, y_offset = points.y_offset, z_offset = points.z_offset;
-
   // Pass 1: classify every point and compact the ground and obstacle returns. With the `planes` ground model the
-  // valid returns are first kept with their zones, the model fitted, and then they are classified.
-  std::size_t n_ground = 0, n_obstacle = 0;
-  std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, self = 0;
-  std::size_t below_ground = 0, gap = 0, above = 0;
+  // valid returns are first kept with their zones, the model fitted, and then they are classified. The points are
+  // cut into chunks (kPointChunk with several threads); each chunk writes its returns from its own first index on, and the chunks'
+  // returns are then moved together in chunk order, so the lists are those of one pass in point order.
+  const Parallel& par = *parallel_;
+  PointPass pass;
+  const Eigen::Matrix3f rot = sensor_pose_.rotation().cast<float>();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) pass.rot[3 * r + c] = rot(r, c);
+  // Points relative to the table's sensor position (within kSensorMoveTolerance of the current one).
+  pass.shift_x = static_cast<float>(sensor_pose_.translation().x() - table_sensor_x_);
+  pass.shift_y = static_cast<float>(sensor_pose_.translation().y() - table_sensor_y_);
+  pass.trans_z = static_cast<float>(sensor_pose_.translation().z());
+  pass.min2 = static_cast<float>(params_.min_range * params_.min_range);
+  pass.max2 = static_cast<float>(params_.max_range * params_.max_range);
+  pass.inv_res = static_cast<float>(1.0 / geometry_.resolution);
+  // Cell coordinates of a point relative to the sensor: (d + sensor − origin) / resolution.
+  pass.cx0 = static_cast<float>((table_sensor_x_ - geometry_.origin_x) / geometry_.resolution);
+  pass.cy0 = static_cast<float>((table_sensor_y_ - geometry_.origin_y) / geometry_.resolution);
+  pass.width = geometry_.width;
+  pass.fwidth = static_cast<float>(geometry_.width);
+  pass.fheight = static_cast<float>(geometry_.height);
+  pass.sector_scale = sector_scale_;
+  pass.num_sectors = num_sectors_;
   // Self box relative to the table's sensor position.
-  const float self_min_x = static_cast<float>(params_.self_box_min_x - table_sensor_x_);
-  const float self_max_x = static_cast<float>(params_.self_box_max_x - table_sensor_x_);
-  const float self_min_y = static_cast<float>(params_.self_box_min_y - table_sensor_y_);
-  const float self_max_y = static_cast<float>(params_.self_box_max_y - table_sensor_y_);
-  const float tolerance = static_cast<float>(params_.ground_tolerance);
-  const float obstacle_min = static_cast<float>(params_.obstacle_min_height);
-  const float obstacle_max = static_cast<float>(params_.obstacle_max_height);
-  const float relative_limit = static_cast<float>(params_.relative_height_limit);
-  // Classifies a valid return at (dx, dy) from the sensor, height z, over ground height g.
-  // sector < 0: not known yet, computed here when needed.
-  const auto classify = [&](float dx, float dy, float z, float r2, float g, int sector) {
-    if (relative)
-    {
-      const float fx = cx0 + dx * inv_res;
-      const float fy = cy0 + dy * inv_res;
-      if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
-      {
-        float& lowest = cell_min_z[static_cast<int>(fy) * width + static_cast<int>(fx)];
-        lowest = std::min(lowest, z);
-      }
-    }
-    const float h = z - g;
-    if (h < -tolerance)
-    {
-      ++below_ground;
-    }
-    else if (h <= tolerance)
-    {
-      ground_sector[n_ground] =
-          static_cast<std::uint32_t>(sector >= 0 ? sector : sectorIndex(dx, dy, sector_scale, num_sectors));
-      ground_range2[n_ground] = r2;
-      ++n_ground;
-    }
-    else if (h < obstacle_min)
-    {
-      ++gap;
-    }
-    else if (h <= obstacle_max)
-    {
-      const float fx = cx0 + dx * inv_res;
-      const float fy = cy0 + dy * inv_res;
-      const bool inside = (fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight);
-      obstacle_sector[n_obstacle] =
-          static_cast<std::uint32_t>(sector >= 0 ? sector : sectorIndex(dx, dy, sector_scale, num_sectors));
-      obstacle_range2[n_obstacle] = r2;
-      obstacle_cell[n_obstacle] =
-          inside ? static_cast<std::uint32_t>(static_cast<int>(fy) * width + static_cast<int>(fx)) : kOutside;
-      obstacle_xy[2 * n_obstacle] = dx;
-      obstacle_xy[2 * n_obstacle + 1] = dy;
-      if (relative) obstacle_z[n_obstacle] = h < relative_limit ? z : kInfinity;
-      ++n_obstacle;
-    }
-    else
-    {
-      ++above;
-    }
-  };
+  pass.self_min_x = static_cast<float>(params_.self_box_min_x - table_sensor_x_);
+  pass.self_max_x = static_cast<float>(params_.self_box_max_x - table_sensor_x_);
+  pass.self_min_y = static_cast<float>(params_.self_box_min_y - table_sensor_y_);
+  pass.self_max_y = static_cast<float>(params_.self_box_max_y - table_sensor_y_);
+  pass.tolerance = static_cast<float>(params_.ground_tolerance);
+  pass.obstacle_min = static_cast<float>(params_.obstacle_min_height);
+  pass.obstacle_max = static_cast<float>(params_.obstacle_max_height);
+  pass.relative_limit = static_cast<float>(params_.relative_height_limit);
+  pass.relative = relative;
+  pass.shared = par.threads() > 1;
+  pass.ground_sector = ground_sector_.data();
+  pass.ground_range2 = ground_range2_.data();
+  pass.obstacle_sector = obstacle_sector_.data();
+  pass.obstacle_range2 = obstacle_range2_.data();
+  pass.obstacle_cell = obstacle_cell_.data();
+  pass.obstacle_xy = obstacle_points_.data();
+  pass.obstacle_z = obstacle_z_.data();
+  pass.cell_min_z = cell_min_z_.data();
+  pass.ground = static_cast<float>(params_.ground_height);
+  pass.data = points.data;
+  pass.cols = points.width;
+  pass.point_step = points.point_step;
+  pass.row_step = points.row_step;
+  pass.x_offset = points.x_offset;
+  pass.y_offset = points.y_offset;
+  pass.z_offset = points.z_offset;
+
   const bool planes = ground_kind_ == GroundModel::kPlanes;
-  std::size_t n_valid = 0;
+  pass.planes = planes;
   if (planes && valid_dx_.size() < n_points)
   {
     valid_dx_.resize(n_points);
@@ -365,63 +433,140 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     valid_z_.resize(n_points);
     valid_zone_.resize(n_points);
   }
-  for (std::size_t row = 0; row < rows; ++row)
-  {
-    const std::uint8_t* p = data + row * row_step;
-    for (std::size_t col = 0; col < cols; ++col, p += point_step)
+  float* const valid_dx = pass.valid_dx = valid_dx_.data();
+  float* const valid_dy = pass.valid_dy = valid_dy_.data();
+  float* const valid_z = pass.valid_z = valid_z_.data();
+  std::uint16_t* const valid_zone = pass.valid_zone = valid_zone_.data();
+  pass.fitter = &ground_;
+  // The lists do not depend on the chunks (each chunk's returns are in point order, and chunks are joined in order),
+  // so one thread takes all the points in one chunk, with nothing to move.
+  const std::size_t chunk_points = pass.shared ? kPointChunk : std::max<std::size_t>(1, n_points);
+  const std::size_t point_chunks = chunkCount(n_points, chunk_points);
+  chunk_returns_.assign(point_chunks, ChunkReturns{});
+  ChunkReturns* const chunk_out = chunk_returns_.data();
+  par.forChunks(point_chunks, [&](std::size_t c) {
+    const PointPass m = pass;  // a local copy, kept in registers: a float store could alias the shared one
+    ChunkReturns out;
+    const std::size_t k0 = c * chunk_points, k1 = std::min(n_points, k0 + chunk_points);
+    out.first = k0;
+    std::size_t row = k0 / m.cols, col = k0 % m.cols;
+    const std::uint8_t* p = m.data + row * m.row_step + col * m.point_step;
+    for (std::size_t k = k0; k < k1; ++k)
     {
-      const float px = readFloat(p + x_offset);
-      const float py = readFloat(p + y_offset);
-      const float pz = readFloat(p + z_offset);
+      const std::uint8_t* const point = p;
+      if (++col == m.cols)
+      {
+        col = 0;
+        ++row;
+        p = m.data + row * m.row_step;
+      }
+      else
+      {
+        p += m.point_step;
+      }
+      const float px = readFloat(point + m.x_offset);
+      const float py = readFloat(point + m.y_offset);
+      const float pz = readFloat(point + m.z_offset);
       if (!(std::isfinite(px) && std::isfinite(py) && std::isfinite(pz)))
       {
-        ++non_finite;
+        ++out.counts.non_finite;
         continue;
       }
       if (px == 0.0f && py == 0.0f && pz == 0.0f)
       {
-        ++no_return;
+        ++out.counts.no_return;
         continue;
       }
-      const float dx = rot(0, 0) * px + rot(0, 1) * py + rot(0, 2) * pz + shift_x;
-      const float dy = rot(1, 0) * px + rot(1, 1) * py + rot(1, 2) * pz + shift_y;
-      const float z = rot(2, 0) * px + rot(2, 1) * py + rot(2, 2) * pz + trans_z;
+      const float dx = m.rot[0] * px + m.rot[1] * py + m.rot[2] * pz + m.shift_x;
+      const float dy = m.rot[3] * px + m.rot[4] * py + m.rot[5] * pz + m.shift_y;
+      const float z = m.rot[6] * px + m.rot[7] * py + m.rot[8] * pz + m.trans_z;
       const float r2 = dx * dx + dy * dy;
-      if (r2 < min2)
+      if (r2 < m.min2)
       {
-        ++below_min;
+        ++out.counts.below_min;
         continue;
       }
-      if (r2 > max2)
+      if (r2 > m.max2)
       {
-        ++beyond_max;
+        ++out.counts.beyond_max;
         continue;
       }
-      if (dx > self_min_x && dx < self_max_x && dy > self_min_y && dy < self_max_y)
+      if (dx > m.self_min_x && dx < m.self_max_x && dy > m.self_min_y && dy < m.self_max_y)
       {
-        ++self;
+        ++out.counts.self;
         continue;
       }
-      if (planes)
+      if (m.planes)
       {
-        valid_dx_[n_valid] = dx;
-        valid_dy_[n_valid] = dy;
-        valid_z_[n_valid] = z;
-        valid_zone_[n_valid] = static_cast<std::uint16_t>(ground_.zoneOf(r2, turnFraction(dx, dy)));
-        ++n_valid;
+        const std::size_t v = k0 + out.valid++;
+        m.valid_dx[v] = dx;
+        m.valid_dy[v] = dy;
+        m.valid_z[v] = z;
+        m.valid_zone[v] = static_cast<std::uint16_t>(m.fitter->zoneOf(r2, turnFraction(dx, dy)));
         continue;
       }
-      classify(dx, dy, z, r2, ground, -1);
+      m.classify(dx, dy, z, r2, m.ground, out);
     }
+    chunk_out[c] = out;
+  });
+  ReturnCounts counts;
+  std::size_t n_valid = 0;
+  for (std::size_t c = 0; c < point_chunks; ++c)
+  {
+    const ChunkReturns& out = chunk_out[c];
+    counts += out.counts;
+    if (!planes) continue;
+    moveSegment(valid_dx, 1, out.first, out.valid, n_valid);
+    moveSegment(valid_dy, 1, out.first, out.valid, n_valid);
+    moveSegment(valid_z, 1, out.first, out.valid, n_valid);
+    moveSegment(valid_zone, 1, out.first, out.valid, n_valid);
+    n_valid += out.valid;
   }
+  std::size_t n_chunks = point_chunks;
   if (planes)
   {
-    st.ground_fit = ground_.fit(valid_dx_.data(), valid_dy_.data(), valid_z_.data(), valid_zone_.data(), n_valid);
-    for (std::size_t i = 0; i < n_valid; ++i)
-    {
-      const float dx = valid_dx_[i], dy = valid_dy_[i];
-      classify(dx, dy, valid_z_[i], dx * dx + dy * dy, ground_.plane(valid_zone_[i]).at(dx, dy), -1);
-    }
+    st.ground_fit = ground_.fit(valid_dx, valid_dy, valid_z, valid_zone, n_valid);
+    const std::size_t chunk_valid = pass.shared ? kPointChunk : std::max<std::size_t>(1, n_valid);
+    n_chunks = chunkCount(n_valid, chunk_valid);
+    valid_returns_.assign(n_chunks, ChunkReturns{});
+    ChunkReturns* const valid_out = valid_returns_.data();
+    par.forChunks(n_chunks, [&](std::size_t c) {
+      const PointPass m = pass;
+      ChunkReturns out;
+      const std::size_t v0 = c * chunk_valid, v1 = std::min(n_valid, v0 + chunk_valid);
+      out.first = v0;
+      for (std::size_t i = v0; i < v1; ++i)
+      {
+        const float dx = m.valid_dx[i], dy = m.valid_dy[i];
+        m.classify(dx, dy, m.valid_z[i], dx * dx + dy * dy, m.fitter->plane(m.valid_zone[i]).at(dx, dy), out);
+      }
+      valid_out[c] = out;
+    });
+    for (std::size_t c = 0; c < n_chunks; ++c) counts += valid_out[c].counts;
+  }
+  std::uint32_t* const ground_sector = pass.ground_sector;
+  float* const ground_range2 = pass.ground_range2;
+  std::uint32_t* const obstacle_sector = pass.obstacle_sector;
+  float* const obstacle_range2 = pass.obstacle_range2;
+  std::uint32_t* const obstacle_cell = pass.obstacle_cell;
+  float* const obstacle_xy = pass.obstacle_xy;
+  float* const obstacle_z = pass.obstacle_z;
+  float* const cell_min_z = pass.cell_min_z;
+  const int width = pass.width;
+  const ChunkReturns* const classified = planes ? valid_returns_.data() : chunk_out;
+  std::size_t n_ground = 0, n_obstacle = 0;
+  for (std::size_t c = 0; c < n_chunks; ++c)
+  {
+    const ChunkReturns& out = classified[c];
+    moveSegment(ground_sector, 1, out.first, out.ground, n_ground);
+    moveSegment(ground_range2, 1, out.first, out.ground, n_ground);
+    moveSegment(obstacle_sector, 1, out.first, out.obstacle, n_obstacle);
+    moveSegment(obstacle_range2, 1, out.first, out.obstacle, n_obstacle);
+    moveSegment(obstacle_cell, 1, out.first, out.obstacle, n_obstacle);
+    moveSegment(obstacle_xy, 2, out.first, out.obstacle, n_obstacle);
+    if (relative) moveSegment(obstacle_z, 1, out.first, out.obstacle, n_obstacle);
+    n_ground += out.ground;
+    n_obstacle += out.obstacle;
   }
   std::size_t low_relief = 0;
   if (relative)
@@ -457,14 +602,14 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     n_obstacle = kept;
   }
   st.low_relief = low_relief;
-  st.non_finite = non_finite;
-  st.no_return = no_return;
-  st.below_min_range = below_min;
-  st.beyond_max_range = beyond_max;
-  st.self_returns = self;
-  st.below_ground = below_ground;
-  st.height_gap = gap;
-  st.above_clearance = above;
+  st.non_finite = counts.non_finite;
+  st.no_return = counts.no_return;
+  st.below_min_range = counts.below_min;
+  st.beyond_max_range = counts.beyond_max;
+  st.self_returns = counts.self;
+  st.below_ground = counts.below_ground;
+  st.height_gap = counts.gap;
+  st.above_clearance = counts.above;
   st.ground = n_ground;
   st.obstacle = n_obstacle;
 
@@ -498,24 +643,35 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const m_o = grid.plane(FrameSG::kO);
   float* const m_omega = grid.plane(FrameSG::kOmega);
   const std::size_t n = geometry_.numCells();
-  std::fill_n(m_empty, n, 0.0f);
-  std::fill_n(m_f, n, 0.0f);
-  std::fill_n(m_o, n, 0.0f);
-  std::fill_n(m_omega, n, 1.0f);
-  std::size_t free_cells = 0;
+  par.forRange(n, kFillChunk, [&](std::size_t i0, std::size_t i1) {
+    std::fill(m_empty + i0, m_empty + i1, 0.0f);
+    std::fill(m_f + i0, m_f + i1, 0.0f);
+    std::fill(m_o + i0, m_o + i1, 0.0f);
+    std::fill(m_omega + i0, m_omega + i1, 1.0f);
+  });
+  // Every cell is in one sector's group, so the sectors' chunks write disjoint cells.
   const TableEntry* const table = table_.data();
-  for (std::size_t s = 0; s < sector_free2_.size(); ++s)
-  {
-    const float limit = free2[s];
-    const std::uint32_t end = sector_begin_[s + 1];
-    for (std::uint32_t k = sector_begin_[s]; k < end && table[k].range2 < limit; ++k)
+  const std::size_t sectors = sector_free2_.size();
+  sector_chunk_free_.assign(chunkCount(sectors, kSectorChunk), 0);
+  std::size_t* const chunk_free = sector_chunk_free_.data();
+  par.forRange(sectors, kSectorChunk, [&](std::size_t s0, std::size_t s1) {
+    std::size_t count = 0;
+    for (std::size_t s = s0; s < s1; ++s)
     {
-      const float f = table[k].mu_free;
-      m_f[table[k].cell] = f;
-      m_omega[table[k].cell] = 1.0f - f;
-      free_cells += f > 0.0f;
+      const float limit = free2[s];
+      const std::uint32_t end = sector_begin_[s + 1];
+      for (std::uint32_t k = sector_begin_[s]; k < end && table[k].range2 < limit; ++k)
+      {
+        const float f = table[k].mu_free;
+        m_f[table[k].cell] = f;
+        m_omega[table[k].cell] = 1.0f - f;
+        count += f > 0.0f;
+      }
     }
-  }
+    chunk_free[s0 / kSectorChunk] = count;
+  });
+  std::size_t free_cells = 0;
+  for (const std::size_t c : sector_chunk_free_) free_cells += c;
 
   const float mu_o = static_cast<float>(params_.mu_occupied);
   std::size_t occupied = 0;

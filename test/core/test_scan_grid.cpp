@@ -486,6 +486,8 @@ TEST(ScanGrid, ParametersAreValidatedByName)
   expectError("mu_free", [](ScanGridParams& p) { p.mu_free = 1.5; });
   expectError("mu_occupied", [](ScanGridParams& p) { p.mu_occupied = std::nan(""); });
   expectError("free_decay_length", [](ScanGridParams& p) { p.free_decay_length = -1.0; });
+  expectError("threads", [](ScanGridParams& p) { p.threads = -1; });
+  expectError("threads", [](ScanGridParams& p) { p.threads = kMaxThreads + 1; });
   EXPECT_NO_THROW(testParams().validate());
   EXPECT_NO_THROW(ScanGridParams().validate());
 
@@ -549,4 +551,192 @@ TEST(ScanGrid, RandomCloudsGiveValidMassesAndObstaclesAlwaysMarked)
       }
     }
   }
+}
+
+namespace {
+
+/// An organized cloud of @p rows × @p cols points, each row padded by 12 bytes (so chunks of points start and end
+/// inside rows), drawn over every class: no return, non-finite, below min range, beyond max range, the vehicle's box,
+/// ground, below ground, height gap, obstacle, above clearance, and obstacles outside the grid.
+struct PaddedCloud
+{
+  std::size_t rows, cols, row_step;
+  std::vector<std::uint8_t> bytes;
+  PaddedCloud(std::size_t r, std::size_t c, unsigned seed) : rows(r), cols(c), row_step(c * sizeof(P) + 12)
+  {
+    bytes.assign(rows * row_step, 0xAB);
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> kind(0, 99);
+    std::uniform_real_distribution<float> xy(-19.0f, 19.0f), angle(-3.14159f, 3.14159f), near(2.0f, 12.0f),
+        far(12.5f, 19.0f), ground(-0.1f, 0.1f), obstacle(0.5f, 2.0f), raised(0.4f, 0.5f), patch(-1.0f, 1.0f);
+    const auto polar = [&](float r, float z) {
+      const float a = angle(rng);
+      return P{ r * std::cos(a), r * std::sin(a), z };
+    };
+    for (std::size_t row = 0; row < rows; ++row)
+      for (std::size_t col = 0; col < cols; ++col)
+      {
+        const int k = kind(rng);
+        P p = polar(near(rng), ground(rng));  // ground out to 12 m
+        if (k < 3) p = { 0.0f, 0.0f, 0.0f };
+        else if (k < 5) p.x = kNaN;
+        else if (k < 7) p = { 0.2f, 0.1f, 0.0f };                   // below min range
+        else if (k < 9) p = { 35.0f, 25.0f, 1.0f };                 // beyond max range
+        else if (k < 11) p = { 1.0f, 0.5f, 1.0f };                  // the vehicle's box
+        else if (k < 14) p.z = -0.6f;                               // below ground
+        else if (k < 17) p = { xy(rng), xy(rng), 0.25f };           // height gap
+        else if (k < 20) p = { xy(rng), xy(rng), 3.0f };            // above clearance
+        else if (k < 22) p = { 21.0f + 0.01f * k, 3.0f, 1.0f };     // obstacle outside the 40 m grid
+        else if (k < 27) p = { 15.0f + patch(rng), patch(rng), raised(rng) };  // a raised patch, no ground around
+        else if (k < 45) p = polar(far(rng), obstacle(rng));        // obstacles beyond 12.5 m
+        std::memcpy(bytes.data() + row * row_step + col * sizeof(P), &p, sizeof p);
+      }
+  }
+  PointCloudView view() const
+  {
+    PointCloudView v;
+    v.data = bytes.data();
+    v.width = cols;
+    v.height = rows;
+    v.point_step = sizeof(P);
+    v.row_step = row_step;
+    return v;
+  }
+  P at(std::size_t row, std::size_t col) const
+  {
+    P p;
+    std::memcpy(&p, bytes.data() + row * row_step + col * sizeof(P), sizeof p);
+    return p;
+  }
+};
+
+ScanGridParams chunkedParams()
+{
+  ScanGridParams p = testParams();
+  p.min_range = 0.5;
+  p.self_box_min_x = 0.5;
+  p.self_box_max_x = 1.5;
+  p.self_box_min_y = 0.0;
+  p.self_box_max_y = 1.0;
+  return p;
+}
+
+}  // namespace
+
+// 100 000 points are 7 chunks: the obstacle returns must come out in point order, each once, with the counts of
+// every class, whatever the thread count.
+TEST(ScanGrid, ObstacleReturnsOfManyChunksAreListedInPointOrder)
+{
+  const PaddedCloud cloud(50, 2000, 11);
+  std::vector<float> expected;
+  std::size_t no_return = 0, non_finite = 0, below_min = 0, beyond_max = 0, self = 0, below_ground = 0, gap = 0;
+  std::size_t above = 0, ground = 0, obstacle = 0;
+  for (std::size_t row = 0; row < cloud.rows; ++row)
+    for (std::size_t col = 0; col < cloud.cols; ++col)
+    {
+      const P p = cloud.at(row, col);
+      const float r2 = p.x * p.x + p.y * p.y;
+      if (!std::isfinite(p.x)) ++non_finite;
+      else if (p.x == 0.0f && p.y == 0.0f && p.z == 0.0f) ++no_return;
+      else if (r2 < 0.25f) ++below_min;
+      else if (r2 > 900.0f) ++beyond_max;
+      else if (p.x > 0.5f && p.x < 1.5f && p.y > 0.0f && p.y < 1.0f) ++self;
+      else if (p.z < -0.2f) ++below_ground;
+      else if (p.z <= 0.2f) ++ground;
+      else if (p.z < 0.3f) ++gap;
+      else if (p.z > 2.5f) ++above;
+      else
+      {
+        ++obstacle;
+        if (std::abs(p.x) < 20.0f && std::abs(p.y) < 20.0f)
+        {
+          expected.push_back(p.x);
+          expected.push_back(p.y);
+        }
+      }
+    }
+  ASSERT_GT(expected.size(), 2 * 10000u);
+  ASSERT_LT(expected.size() / 2, obstacle) << "some obstacles must fall outside the grid";
+  for (int threads : { 1, 2, 4 })
+  {
+    ScanGridParams params = chunkedParams();
+    params.threads = threads;
+    ScanGridBuilder builder(params, Eigen::Isometry3d::Identity());
+    ScanMassGrid grid;
+    ScanGridStats st;
+    ASSERT_TRUE(builder.build(cloud.view(), grid, &st));
+    EXPECT_EQ(st.no_return, no_return) << threads;
+    EXPECT_EQ(st.non_finite, non_finite) << threads;
+    EXPECT_EQ(st.below_min_range, below_min) << threads;
+    EXPECT_EQ(st.beyond_max_range, beyond_max) << threads;
+    EXPECT_EQ(st.self_returns, self) << threads;
+    EXPECT_EQ(st.below_ground, below_ground) << threads;
+    EXPECT_EQ(st.height_gap, gap) << threads;
+    EXPECT_EQ(st.above_clearance, above) << threads;
+    EXPECT_EQ(st.ground, ground) << threads;
+    EXPECT_EQ(st.obstacle, obstacle) << threads;
+    EXPECT_EQ(st.obstacle_outside_grid, obstacle - expected.size() / 2) << threads;
+    const ObstaclePoints got = builder.obstaclePoints();
+    ASSERT_EQ(got.count, expected.size() / 2) << threads;
+    EXPECT_EQ(std::memcmp(got.xy, expected.data(), expected.size() * sizeof(float)), 0)
+        << threads << " threads: the obstacle returns differ from the cloud's, in point order";
+  }
+}
+
+// The grid, the counts and the obstacle returns of a cloud of many chunks are the same, byte for byte, for 1, 2 and
+// 4 threads, with both ground models and with and without the relative obstacle height (its lowest return per cell
+// is shared between the chunks).
+TEST(ScanGrid, ManyChunksGiveTheSameGridForAnyThreadCount)
+{
+  const PaddedCloud cloud(64, 2100, 5);
+  for (const char* model : { "flat", "planes" })
+    for (double relative : { 0.0, 0.8 })
+    {
+      std::vector<std::uint8_t> first_planes;
+      std::vector<float> first_obstacles;
+      ScanGridStats first;
+      for (int threads : { 1, 2, 4 })
+      {
+        ScanGridParams params = chunkedParams();
+        params.ground_model = model;
+        params.relative_height_limit = relative;
+        params.threads = threads;
+        ScanGridBuilder builder(params, Eigen::Isometry3d::Identity());
+        ScanMassGrid grid;
+        ScanGridStats st;
+        ASSERT_TRUE(builder.build(cloud.view(), grid, &st));
+        std::vector<std::uint8_t> planes;
+        for (Subset a : { FrameSG::kEmpty, FrameSG::kF, FrameSG::kO, FrameSG::kOmega })
+        {
+          const auto* b = reinterpret_cast<const std::uint8_t*>(grid.plane(a));
+          planes.insert(planes.end(), b, b + grid.numCells() * sizeof(float));
+        }
+        const ObstaclePoints obs = builder.obstaclePoints();
+        const std::vector<float> obstacles(obs.xy, obs.xy + 2 * obs.count);
+        if (threads == 1)
+        {
+          first_planes = planes;
+          first_obstacles = obstacles;
+          first = st;
+          EXPECT_GT(st.free_cells, 1000u) << model;
+          EXPECT_GT(st.occupied_cells, 1000u) << model;
+          if (relative > 0.0)
+          {
+            EXPECT_GT(st.low_relief, 0u) << model;
+          }
+          continue;
+        }
+        const std::string what = std::string(model) + ", relative " + std::to_string(relative) + ", " +
+                                 std::to_string(threads) + " threads";
+        EXPECT_TRUE(planes == first_planes) << what << ": the grid differs";
+        EXPECT_TRUE(obstacles == first_obstacles) << what << ": the obstacle returns differ";
+        EXPECT_EQ(st.ground, first.ground) << what;
+        EXPECT_EQ(st.obstacle, first.obstacle) << what;
+        EXPECT_EQ(st.low_relief, first.low_relief) << what;
+        EXPECT_EQ(st.free_cells, first.free_cells) << what;
+        EXPECT_EQ(st.occupied_cells, first.occupied_cells) << what;
+        EXPECT_EQ(st.below_ground, first.below_ground) << what;
+        EXPECT_EQ(st.ground_fit.fitted, first.ground_fit.fitted) << what;
+      }
+    }
 }

@@ -40,6 +40,7 @@
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/core/ground_model.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
+#include "map_aided_fusion/core/parallel.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -110,6 +111,12 @@ struct ScanGridParams
   double ground_search_band = 0.6;      ///< m, a zone's candidates lie within this of the predicted ground, (0, 10]
   double ground_fit_tolerance = 0.08;   ///< m, RANSAC inlier distance, (0, ground_search_band]
 
+  /**
+   * Threads of build(), in [0, kMaxThreads]; 0: every core. The grid, the obstacle returns and the counts are
+   * bit-identical for any number (the points are cut into chunks that depend only on the cloud's size).
+   */
+  int threads = 0;
+
   /// ground_model parsed.
   GroundModel groundModel() const { return parseGroundModel(ground_model); }
   /// The `planes` model's parameters.
@@ -165,6 +172,7 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("ground_min_points", p.ground_min_points);
   get("ground_search_band", p.ground_search_band);
   get("ground_fit_tolerance", p.ground_fit_tolerance);
+  get("threads", p.threads);
 }
 
 /// Largest grid the builder accepts (cells), to refuse absurd sizes before allocating.
@@ -312,6 +320,34 @@ private:
   std::vector<float> valid_dx_, valid_dy_, valid_z_;
   std::vector<std::uint16_t> valid_zone_;
   GroundPlaneFitter ground_;
+
+  // Threads of build() (ScanGridParams::threads) and what each chunk of points found.
+  std::shared_ptr<const Parallel> parallel_;
+  struct ReturnCounts
+  {
+    std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, self = 0;
+    std::size_t below_ground = 0, gap = 0, above = 0;
+    ReturnCounts& operator+=(const ReturnCounts& o)
+    {
+      non_finite += o.non_finite;
+      no_return += o.no_return;
+      below_min += o.below_min;
+      beyond_max += o.beyond_max;
+      self += o.self;
+      below_ground += o.below_ground;
+      gap += o.gap;
+      above += o.above;
+      return *this;
+    }
+  };
+  /// A chunk's returns start at index `first` of each list (its first point or valid return).
+  struct ChunkReturns
+  {
+    std::size_t first = 0, valid = 0, ground = 0, obstacle = 0;
+    ReturnCounts counts;
+  };
+  std::vector<ChunkReturns> chunk_returns_, valid_returns_;
+  std::vector<std::size_t> sector_chunk_free_;
 };
 
 }  // namespace core
