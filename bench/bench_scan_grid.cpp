@@ -1,5 +1,5 @@
-// ScanGrid construction: a 64-beam-like cloud into a 160 m × 160 m grid at 0.2 m (BM_ScanGrid/N; with the
-// `planes` ground model BM_ScanGridGround/N; its deskewing at 15 m/s BM_Deskew/N), the
+// ScanGrid construction: a 64-beam-like cloud into a 160 m × 160 m grid at 0.2 m (BM_ScanGrid/points:N/threads:T;
+// with the `planes` ground model BM_ScanGridGround/points:N/threads:T; its deskewing at 15 m/s BM_Deskew/N), the
 // paper's IBEO Alaska XT case (4 layers, ~800 points, 0.5 m cells; BM_ScanGridPaper/N), and the one-off
 // cost of the geometry table (BM_ScanGridTable).
 #include <benchmark/benchmark.h>

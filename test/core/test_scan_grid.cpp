@@ -623,8 +623,8 @@ ScanGridParams chunkedParams()
 
 }  // namespace
 
-// 100 000 points are 7 chunks: the obstacle returns must come out in point order, each once, with the counts of
-// every class, whatever the thread count.
+// 100 000 points are one chunk with one thread and 7 with more: the obstacle returns must come out in point order,
+// each once, with the counts of every class, whatever the thread count.
 TEST(ScanGrid, ObstacleReturnsOfManyChunksAreListedInPointOrder)
 {
   const PaddedCloud cloud(50, 2000, 11);
