@@ -69,37 +69,33 @@ void BM_FusionStep(benchmark::State& state)
   setCells(state, n);
 }
 
-/// Reads every plane the fusion step reads (the 29 stored mass planes, ζ, 3 scan planes, 3 prior planes) and
-/// writes the mass planes and ζ: the memory traffic of BM_FusionStep with no arithmetic, with the same
-/// blocking, prefetching, chunks and threads. Args: N, threads.
+/// Reads everything the fusion step reads (the MapGrid's blocks: 29 stored masses and ζ per cell; 3 scan planes,
+/// 3 prior planes) and writes the blocks: the memory traffic of BM_FusionStep with no arithmetic, in the same
+/// layout, chunks and threads. Args: N, threads.
 void BM_StreamBaseline(benchmark::State& state)
 {
   const int n = static_cast<int>(state.range(0));
   const Parallel parallel(static_cast<int>(state.range(1)));
   Scene scene(n);
   const std::size_t cells = scene.map.numCells();
-  const std::size_t stride = scene.map.stride();
-  constexpr std::size_t kBlock = 16, kAhead = 256;
+  constexpr std::size_t kBlock = MapMassGrid::kBlockCells;
+  constexpr int kSlots = MapMassGrid::kNumPlanes + 1;  // and ζ
   for (auto _ : state)
   {
     float* base = scene.map.planes();
-    constexpr int kPlanes = MapMassGrid::kNumPlanes;  // and ζ after them
     const float* in[6] = { scene.scan.plane(FrameSG::kF), scene.scan.plane(FrameSG::kO),
                            scene.scan.plane(FrameSG::kOmega), scene.prior.building.data(),
                            scene.prior.road.data(), scene.prior.other.data() };
     parallel.forRange(cells, kFusionChunkCells, [&](std::size_t c0, std::size_t c1) {
       for (std::size_t i0 = c0; i0 < c1; i0 += kBlock)
       {
-        for (int a = 0; a <= kPlanes; ++a) __builtin_prefetch(base + a * stride + i0 + kAhead, 1, 0);
         const std::size_t len = std::min(kBlock, c1 - i0);
         float add[kBlock] = {};
         for (const float* p : in)
           for (std::size_t k = 0; k < len; ++k) add[k] += p[i0 + k];
-        for (int a = 0; a <= kPlanes; ++a)
-        {
-          float* plane = base + a * stride + i0;
-          for (std::size_t k = 0; k < len; ++k) plane[k] = plane[k] * 0.5f + add[k];
-        }
+        float* block = base + MapMassGrid::blockOffset(i0);
+        for (int a = 0; a < kSlots; ++a)
+          for (std::size_t k = 0; k < len; ++k) block[a * kBlock + k] = block[a * kBlock + k] * 0.5f + add[k];
       }
     });
     benchmark::ClobberMemory();

@@ -74,23 +74,45 @@ MAF_INLINE Vec8 load<Vec8>(const float* p)
 MAF_INLINE void store(float* p, float v) { *p = v; }
 MAF_INLINE void store(float* p, Vec8 v) { __builtin_memcpy(p, &v, sizeof v); }
 
-/// m[a] of one cell of a MapGrid's planes (slot order from @p base, @p stride floats apart); a subset the grid does
-/// not store is a compile-time zero, so the arithmetic on it folds away where the translation unit allows it.
+/// Floats between two slots of one MapGrid cell (the cells of a block are consecutive).
+constexpr std::size_t kSlotStride = MapMassGrid::kBlockCells;
+static_assert(MapMassGrid::kInterleaved && MapMassGrid::kBlockCells == 8, "one Vec8 per slot of a block");
+
+/// Where cell @p i of the MapGrid whose first float is @p base starts (slot s is kSlotStride · s further): for a
+/// Vec8, @p i is a multiple of eight and the block's slots are consecutive vectors.
+MAF_INLINE float* cellAt(float* base, std::size_t i) { return base + MapMassGrid::blockOffset(i); }
+MAF_INLINE const float* cellAt(const float* base, std::size_t i) { return base + MapMassGrid::blockOffset(i); }
+/// ζ of cell @p i.
+MAF_INLINE float* zetaAt(float* base, std::size_t i) { return cellAt(base, i) + kMapPlanes * kSlotStride; }
+
+/// m[a] of cell @p i of a MapGrid; a subset the grid does not store is a compile-time zero, so the arithmetic on
+/// it folds away where the translation unit allows it.
 template <typename T>
-MAF_INLINE void loadMasses(const float* base, std::size_t stride, std::size_t i, T (&m)[kSubsets])
+MAF_INLINE void loadMasses(const float* base, std::size_t i, T (&m)[kSubsets])
 {
+  const float* cell = cellAt(base, i);
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a)
-    m[a] = MapMassGrid::kSlots[a] >= 0 ? load<T>(base + MapMassGrid::kSlots[a] * stride + i) : T{};
+    m[a] = MapMassGrid::kSlots[a] >= 0 ? load<T>(cell + MapMassGrid::kSlots[a] * kSlotStride) : T{};
 }
 
 /// Stores the stored subsets of @p m (the others must be zero: they are not kept).
 template <typename T>
-MAF_INLINE void storeMasses(float* base, std::size_t stride, std::size_t i, const T (&m)[kSubsets])
+MAF_INLINE void storeMasses(float* base, std::size_t i, const T (&m)[kSubsets])
 {
+  float* cell = cellAt(base, i);
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a)
-    if (MapMassGrid::kSlots[a] >= 0) store(base + MapMassGrid::kSlots[a] * stride + i, m[a]);
+    if (MapMassGrid::kSlots[a] >= 0) store(cell + MapMassGrid::kSlots[a] * kSlotStride, m[a]);
+}
+
+/// max(v, 0). Written as one conditional expression so that GCC emits a single max where the translation unit
+/// assumes finite values without signed zeros (a select on a separately computed mask stays a compare and an and).
+template <typename T>
+MAF_INLINE T positivePart(T v)
+{
+  const T zero{};
+  return v > zero ? v : zero;
 }
 
 /// Sum of the lanes.
@@ -102,31 +124,15 @@ MAF_INLINE float horizontalSum(Vec8 v)
   return s;
 }
 
-/// Cells per block of the whole-grid loops: one cache line of each plane.
-constexpr std::size_t kBlockCells = 16;
-/// How far ahead (in cells) the loops prefetch each plane: dozens of concurrent plane streams are more
-/// than the hardware prefetcher follows.
-constexpr std::size_t kPrefetchCells = 256;
-
-/// Prefetches, for writing, the line kPrefetchCells ahead of @p p in @p planes planes of @p stride floats.
-MAF_INLINE void prefetchPlanes(const float* p, std::size_t stride, int planes)
-{
-  for (int a = 0; a < planes; ++a) __builtin_prefetch(p + a * stride + kPrefetchCells, 1, 0);
-}
-
 /**
- * Runs body(T{}, i) over cells [0, n): with T = Vec8 for whole groups of eight cells, then T = float for
- * the rest. Every kBlockCells cells it prefetches @p planes planes of @p stride floats from @p base.
+ * Runs body(T{}, i) over cells [0, n): with T = Vec8 for whole groups of eight cells (one block of the MapGrid),
+ * then T = float for the rest. The MapGrid's blocks are one stream, which the hardware prefetchers follow.
  */
 template <class Body>
-MAF_INLINE void forEachCell(std::size_t n, const float* base, std::size_t stride, int planes, Body&& body)
+MAF_INLINE void forEachCell(std::size_t n, Body&& body)
 {
   std::size_t i = 0;
-  for (; i + kLanes <= n; i += kLanes)
-  {
-    if (base && i % kBlockCells == 0) prefetchPlanes(base + i, stride, planes);
-    body(Vec8{}, i);
-  }
+  for (; i + kLanes <= n; i += kLanes) body(Vec8{}, i);
   for (; i < n; ++i) body(float{}, i);
 }
 
@@ -402,7 +408,7 @@ MAF_INLINE void renormalise(T (&m)[kSubsets])
   MAF_UNROLL
   for (int a = 0; a < kSubsets; ++a)
   {
-    m[a] = select(m[a] > zero, m[a], zero);
+    m[a] = positivePart(m[a]);
     sum += m[a];
   }
   const T one = splat<T>(1.0f);
@@ -435,8 +441,8 @@ MAF_INLINE T updateCounter(T zeta, T m_occupied, T conflict, float delta_inc, fl
   const T one = splat<T>(1.0f), zero = T{};
   const T inc = zeta + delta_inc;
   const T dec = zeta - delta_dec;
-  const T up = select(inc < one, inc, one);
-  const T down = select(dec > zero, dec, zero);
+  const T up = inc < one ? inc : one;
+  const T down = dec > zero ? dec : zero;
   return select(conflict > gamma_conflict, down, select(m_occupied >= gamma_o, up, zeta));
 }
 

@@ -73,8 +73,6 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   const ContextualDiscountWeights<float> w(params.discount);
   kernels::StepInputs in;
   in.base = map.planes();
-  in.zeta = map.counter();
-  in.stride = map.stride();
   in.cells = map.numCells();
   in.sf = scan.plane(FrameSG::kF);
   in.so = scan.plane(FrameSG::kO);
@@ -104,6 +102,7 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
   const bool has_prior = prior != nullptr, wall = prior && prior->hasWall();
   // Fixed chunks (independent of the thread count), their statistics summed in chunk order: bit-identical results.
+  static_assert(kFusionChunkCells % MapMassGrid::kBlockCells == 0, "chunks start on a block of the MapGrid");
   const std::size_t chunks = chunkCount(in.cells, kFusionChunkCells);
   std::vector<FusionStepStats> partial(chunks);
   auto chunk = [&](std::size_t c) {

@@ -8,20 +8,45 @@ namespace kernels {
 
 namespace {
 
+/// The chunk's conflict sums: one per lane of the vector cells (reduced once, in lane order, at the end), then the
+/// remainder cells; the same order for any thread count, since the chunks are.
+struct ConflictSums
+{
+  Vec8 lanes[3] = {};
+  float tail[3] = {};
+
+  MAF_INLINE void add(const CellConflicts<Vec8>& c)
+  {
+    lanes[0] += c.free_occupied;
+    lanes[1] += c.occupied_free;
+    lanes[2] += c.other;
+  }
+  MAF_INLINE void add(const CellConflicts<float>& c)
+  {
+    tail[0] += c.free_occupied;
+    tail[1] += c.occupied_free;
+    tail[2] += c.other;
+  }
+  void reduce(FusionStepStats& stats) const
+  {
+    stats.sum_conflict_free_occupied = horizontalSum(lanes[0]) + tail[0];
+    stats.sum_conflict_occupied_free = horizontalSum(lanes[1]) + tail[1];
+    stats.sum_conflict_other = horizontalSum(lanes[2]) + tail[2];
+  }
+};
+
 /// kPaper: the paper's method (⊛, contextual discounting, counter) compiled without the ablation branches,
 /// which costs about a fifth of the time; otherwise the options are read at run time.
 template <bool kHasPrior, bool kPaper, bool kWall>
 MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights<float>& w, FusionStepStats& stats)
 {
   float* __restrict base = in.base;
-  float* __restrict zeta = in.zeta;
-  const std::size_t stride = in.stride;
-  float sum_fo = 0.0f, sum_of = 0.0f, sum_other = 0.0f;
+  ConflictSums sums;
   const ContextualDiscountWeights8 w8(w);
-  forEachCell(in.cells, base, stride, kMapPlanes + 1, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  forEachCell(in.cells, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     T m[kSubsets];
-    loadMasses(base, stride, i, m);
+    loadMasses(base, i, m);
     T sp[kNumScanPrior];
     const T zero{};
     scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i), kHasPrior ? load<T>(in.pb + i) : zero,
@@ -34,14 +59,15 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     const auto c = modifiedYager<kWall>(m, sp, kPaper ? kRuleModifiedYager : in.rule);
     if (kPaper || in.use_counter)
     {
-      const T z = updateCounter(load<T>(zeta + i), occupiedMass(m), c.free_occupied + c.occupied_free, in.delta_inc,
+      float* const zeta = zetaAt(base, i);
+      const T z = updateCounter(load<T>(zeta), occupiedMass(m), c.free_occupied + c.occupied_free, in.delta_inc,
                                 in.delta_dec, in.gamma_occupied, in.gamma_conflict);
-      store(zeta + i, z);
+      store(zeta, z);
       specialise(m, z, in.literal);
     }
     if (in.moving_expiry) expireMoving(m, load<T>(in.so + i));
     renormalise(m);
-    storeMasses(base, stride, i, m);
+    storeMasses(base, i, m);
     if (in.betp[0])
     {
       T p[FrameMG::kSize];
@@ -49,13 +75,9 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       MAF_UNROLL
       for (int e = 0; e < FrameMG::kSize; ++e) store(in.betp[e] + i, p[e]);
     }
-    sum_fo += horizontalSum(c.free_occupied);
-    sum_of += horizontalSum(c.occupied_free);
-    sum_other += horizontalSum(c.other);
+    sums.add(c);
   });
-  stats.sum_conflict_free_occupied = sum_fo;
-  stats.sum_conflict_occupied_free = sum_of;
-  stats.sum_conflict_other = sum_other;
+  sums.reduce(stats);
   stats.num_cells = in.cells;
 }
 

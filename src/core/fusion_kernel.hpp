@@ -8,6 +8,7 @@
 
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/fusion.hpp"
+#include "map_aided_fusion/core/mass_grid.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -16,9 +17,7 @@ namespace kernels {
 /// Everything the fused loop reads, hoisted out of it.
 struct StepInputs
 {
-  float* base;
-  float* zeta;
-  std::size_t stride;
+  float* base;  ///< the MapGrid's first float (interleaved blocks: masses and ζ of each cell)
   std::size_t cells;
   const float* sf;
   const float* so;
@@ -36,15 +35,15 @@ struct StepInputs
   bool moving_expiry;
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
 
-  /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved, the plane stride kept.
+  /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved. @p begin must start a block
+  /// of the MapGrid (a multiple of MapMassGrid::kBlockCells).
   StepInputs offset(std::size_t begin, std::size_t count) const
   {
     StepInputs o = *this;
     auto move = [begin](auto*& p) {
       if (p) p += begin;
     };
-    move(o.base);
-    move(o.zeta);
+    o.base += MapMassGrid::blockOffset(begin);
     move(o.sf);
     move(o.so);
     move(o.sw);

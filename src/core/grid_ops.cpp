@@ -27,17 +27,18 @@ void refineGrid(const ScanMassGrid& scan, MapMassGrid& out)
   const float* __restrict f = scan.plane(FrameSG::kF);
   const float* __restrict o = scan.plane(FrameSG::kO);
   const float* __restrict w = scan.plane(FrameSG::kOmega);
-  for (int a = 1; a < kSubsets; ++a)  // m_SG(∅) has no plane in a MapGrid; the fusion never reads it
-  {
-    if (!MapMassGrid::stored(static_cast<Subset>(a))) continue;
-    float* __restrict dst = out.plane(static_cast<Subset>(a));
-    const float* src = a == FrameMG::kF ? f : a == FrameMG::kO ? o : a == FrameMG::kOmega ? w : nullptr;
-    if (src)
-      std::copy(src, src + n, dst);
-    else
-      std::fill(dst, dst + n, 0.0f);
-  }
-  std::fill(out.counter(), out.counter() + n, 0.0f);
+  // m_SG(∅) has no slot in a MapGrid; the fusion never reads it.
+  float* __restrict base = out.planes();
+  kernels::forEachCell(n, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+    using T = decltype(lane);
+    using kernels::load;
+    T m[kSubsets] = {};
+    m[FrameMG::kF] = load<T>(f + i);
+    m[FrameMG::kO] = load<T>(o + i);
+    m[FrameMG::kOmega] = load<T>(w + i);
+    kernels::storeMasses(base, i, m);
+    kernels::store(kernels::zetaAt(base, i), T{});
+  });
 }
 
 MAF_TARGET_CLONES
@@ -45,18 +46,17 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
 {
   requireSameGeometry(grid.geometry(), prior.geometry, "combineWithPriorGrid");
   const std::size_t n = grid.numCells();
-  const std::size_t stride = grid.stride();
   float* __restrict base = grid.planes();
   const float* __restrict pb = prior.building.data();
   const float* __restrict pr = prior.road.data();
   const float* __restrict pt = prior.other.data();
   const float* __restrict pw = prior.wall.data();
   const float threshold = static_cast<float>(kTotalConflictThreshold);
-  kernels::forEachCell(n, base, stride, kernels::kMapPlanes, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     using kernels::load;
     T m[kSubsets];
-    kernels::loadMasses(base, stride, i, m);
+    kernels::loadMasses(base, i, m);
     const T b = load<T>(pb + i), r = load<T>(pr + i), t = load<T>(pt + i), wl = load<T>(pw + i);
     const T one = kernels::splat<T>(1.0f), zero{};
     const T u = one - b - r - t - wl;
@@ -78,7 +78,7 @@ void combineWithPriorGrid(MapMassGrid& grid, const PriorWindow& prior)
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) c[a] *= inv;
     c[FrameMG::kOmega] += kernels::select(total, one, zero);
-    kernels::storeMasses(base, stride, i, c);
+    kernels::storeMasses(base, i, c);
   });
 }
 
@@ -87,15 +87,14 @@ void contextualDiscountGrid(MapMassGrid& grid, const ContextualRates& rates)
 {
   const ContextualDiscountWeights<float> w(rates);
   const std::size_t n = grid.numCells();
-  const std::size_t stride = grid.stride();
   float* __restrict base = grid.planes();
   const kernels::ContextualDiscountWeights8 w8(w);
-  kernels::forEachCell(n, base, stride, kernels::kMapPlanes, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     T m[kSubsets];
-    kernels::loadMasses(base, stride, i, m);
+    kernels::loadMasses(base, i, m);
     kernels::contextualDiscount(m, kernels::weightsFor<T>(w, w8, lane));
-    kernels::storeMasses(base, stride, i, m);
+    kernels::storeMasses(base, i, m);
   });
 }
 
@@ -106,17 +105,17 @@ void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassG
   requireSameGeometry(map.geometry(), scan.geometry(), "modifiedYagerGrid");
   if (&out != &map && out.geometry() != map.geometry()) out.reset(map.geometry());
   const std::size_t n = map.numCells();
-  const std::size_t stride = map.stride();
   const float* mb = map.planes();
   const float* sb = scan.planes();
   float* ob = out.planes();
-  if (&out != &map) std::copy(map.counter(), map.counter() + n, out.counter());
-  kernels::forEachCell(n, nullptr, stride, 0, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  if (&out != &map)
+    for (std::size_t i = 0; i < n; ++i) out.zeta(i) = map.zeta(i);
+  kernels::forEachCell(n, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     using kernels::load;
     T m1[kSubsets], m2[kSubsets], c[kSubsets];
-    kernels::loadMasses(mb, stride, i, m1);
-    kernels::loadMasses(sb, stride, i, m2);
+    kernels::loadMasses(mb, i, m1);
+    kernels::loadMasses(sb, i, m2);
     MAF_UNROLL
     for (int a = 0; a < kSubsets; ++a) c[a] = T{};
     MAF_UNROLL
@@ -130,7 +129,7 @@ void modifiedYagerGrid(const MapMassGrid& map, const MapMassGrid& scan, MapMassG
     c[FrameMG::kV] += fo;
     c[FrameMG::kOmega] += c[0] - fo;
     c[0] = T{};
-    kernels::storeMasses(ob, stride, i, c);
+    kernels::storeMasses(ob, i, c);
     if (conflict_free_occupied) kernels::store(conflict_free_occupied + i, fo);
     if (conflict_occupied_free) kernels::store(conflict_occupied_free + i, of);
   });
@@ -142,22 +141,21 @@ void updateCounterAndSpecialiseGrid(MapMassGrid& grid, const float* conflict_fre
 {
   params.validate();
   const std::size_t n = grid.numCells();
-  const std::size_t stride = grid.stride();
   float* __restrict base = grid.planes();
-  float* __restrict zeta = grid.counter();
   const float di = static_cast<float>(params.delta_inc), dd = static_cast<float>(params.delta_dec);
   const float go = static_cast<float>(params.gamma_occupied), gc = static_cast<float>(params.gamma_conflict);
   const bool literal = params.mode == SpecialisationMode::kLiteral;
-  kernels::forEachCell(n, base, stride, kernels::kMapPlanes + 1, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     using kernels::load;
     T m[kSubsets];
-    kernels::loadMasses(base, stride, i, m);
+    kernels::loadMasses(base, i, m);
     const T conflict = load<T>(conflict_free_occupied + i) + load<T>(conflict_occupied_free + i);
-    const T z = kernels::updateCounter(load<T>(zeta + i), kernels::occupiedMass(m), conflict, di, dd, go, gc);
-    kernels::store(zeta + i, z);
+    float* const zeta = kernels::zetaAt(base, i);
+    const T z = kernels::updateCounter(load<T>(zeta), kernels::occupiedMass(m), conflict, di, dd, go, gc);
+    kernels::store(zeta, z);
     kernels::specialise(m, z, literal);
-    kernels::storeMasses(base, stride, i, m);
+    kernels::storeMasses(base, i, m);
   });
 }
 
@@ -165,7 +163,6 @@ MAF_TARGET_CLONES
 void pignisticGrid(const MapMassGrid& grid, PignisticPlanes& out)
 {
   const std::size_t n = grid.numCells();
-  const std::size_t stride = grid.stride();
   for (auto& p : out.p) p.resize(n);
   const float* __restrict base = grid.planes();
   float* __restrict p0 = out.p[0].data();
@@ -173,10 +170,10 @@ void pignisticGrid(const MapMassGrid& grid, PignisticPlanes& out)
   float* __restrict p2 = out.p[2].data();
   float* __restrict p3 = out.p[3].data();
   float* __restrict p4 = out.p[4].data();
-  kernels::forEachCell(n, base, stride, kernels::kMapPlanes, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
+  kernels::forEachCell(n, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
     T m[kSubsets];
-    kernels::loadMasses(base, stride, i, m);
+    kernels::loadMasses(base, i, m);
     T p[FrameMG::kSize];
     kernels::pignistic(m, p);
     kernels::store(p0 + i, p[0]);

@@ -22,11 +22,14 @@ constexpr int kMaxWindowCells = 8192;
 constexpr int kProjectTile = 32;
 constexpr std::size_t kClearanceRows = 64;     // rows per chunk of the clearance's row pass
 constexpr std::size_t kClearanceColumns = 256;  // columns per chunk of its column pass
-constexpr std::size_t kCellChunk = 16384;      // cells per chunk of the per-cell passes
+constexpr std::size_t kCellChunk = 16384;      // cells per chunk of the per-cell passes (whole MapGrid blocks)
+static_assert(kCellChunk % MapMassGrid::kBlockCells == 0, "chunks start on a block");
 constexpr std::size_t kPriorRows = 32;         // rows per chunk of the prior window's copy
 constexpr std::size_t kMarkChunk = 32768;       // scan cells or returns per chunk of the occupancy marks
 constexpr std::size_t kSpreadChunk = 256;      // cells per chunk of motion spreading's cell pass
-constexpr std::size_t kSpreadAhead = 4;        // cells ahead whose planes that pass prefetches
+constexpr std::size_t kSpreadAhead = 4;        // cells ahead whose blocks that pass prefetches
+constexpr std::size_t kFloatsPerLine = 16;     // floats per cache line
+constexpr std::size_t kShiftRows = 16;         // window rows per chunk of a shift's column move
 /// Bounds of memory_budget_mb, MiB.
 constexpr double kMinBudgetMb = 1.0;
 constexpr double kMaxBudgetMb = 1048576.0;
@@ -477,8 +480,25 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
 
 namespace {
 
-/// decide() on the cells [i0, i1); the output (bytes may alias anything) is written through a restricted pointer
-/// so that the loop vectorises.
+/// m(Ω) of the cells [i0, i1) of @p grid (@p i0 starts a block), into @p out[0, i1 − i0).
+void gatherOmega(const MapMassGrid& grid, std::size_t i0, std::size_t i1, float* __restrict out)
+{
+  constexpr std::size_t kB = MapMassGrid::kBlockCells;
+  const float* __restrict omega = grid.planes() + grid.stride() * MapMassGrid::slot(FrameMG::kOmega);
+  std::size_t i = i0;
+  for (; i + kB <= i1; i += kB) std::memcpy(out + (i - i0), omega + MapMassGrid::blockOffset(i), kB * sizeof(float));
+  for (; i < i1; ++i) out[i - i0] = omega[MapMassGrid::blockOffset(i)];
+}
+
+/// The calling thread's buffer for gatherOmega() over one chunk of kCellChunk cells.
+float* omegaBuffer()
+{
+  thread_local AlignedVector<float> buffer(kCellChunk);
+  return buffer.data();
+}
+
+/// decide() on the cells [i0, i1), whose m(Ω) are @p omega[0, i1 − i0); the output (bytes may alias anything) is
+/// written through a restricted pointer so that the loop vectorises.
 void decideCells(const float* __restrict omega, const float* const* p, float t, std::int8_t* __restrict d,
                  std::size_t i0, std::size_t i1)
 {
@@ -499,7 +519,7 @@ void decideCells(const float* __restrict omega, const float* const* p, float t, 
       best_p = better ? q[e] : best_p;
       best = better ? static_cast<std::int8_t>(e) : best;
     }
-    const bool known = omega[i] < 1.0f - kVacuousTolerance && best_p >= t;
+    const bool known = omega[i - i0] < 1.0f - kVacuousTolerance && best_p >= t;
     d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
   }
 }
@@ -512,12 +532,14 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
   const std::size_t n = grid.numCells();
   out.resize(n);
   const Parallel& par = orSerial(parallel);
-  const float* omega = grid.plane(FrameMG::kOmega);
   const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
   const float t = static_cast<float>(threshold);
   std::int8_t* const d = out.data();
-  par.forRange(n, kCellChunk,
-               [&](std::size_t i0, std::size_t i1) { decideCells(omega, p, t, d, i0, i1); });
+  par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
+    float* const omega = omegaBuffer();
+    gatherOmega(grid, i0, i1, omega);
+    decideCells(omega, p, t, d, i0, i1);
+  });
 }
 
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
@@ -530,15 +552,16 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
   const float* pv = betp[FrameMG::kSize - 1].data();
   const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
   const float* pf = betp[0].data();
-  const float* omega = grid.plane(FrameMG::kOmega);
   const float t = static_cast<float>(params.decision_threshold);
   const auto unknown = static_cast<std::int8_t>(CellClass::kUnknown);
   std::int8_t* const d = out.data();
   orSerial(parallel).forRange(out.size(), kCellChunk, [&](std::size_t i0, std::size_t i1) {
+    float* const omega = omegaBuffer();
+    gatherOmega(grid, i0, i1, omega);
     for (std::size_t i = i0; i < i1; ++i)
     {
       const bool tie = (d[i] == stopped || d[i] == moving) && std::abs(ps[i] - pv[i]) < margin;
-      const bool unclassified = d[i] == unknown && omega[i] < 1.0f - kVacuousTolerance && 1.0f - pf[i] >= t;
+      const bool unclassified = d[i] == unknown && omega[i - i0] < 1.0f - kVacuousTolerance && 1.0f - pf[i] >= t;
       if (tie || unclassified) d[i] = static_cast<std::int8_t>(CellClass::kOccupied);
     }
   });
@@ -594,19 +617,19 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
   // The regions are disjoint and each cell's new masses depend on that cell alone: fixed chunks of the cells in
   // parallel, each cell's planes asked for a few cells ahead (they are scattered over the window).
   float* const base = grid.planes();
-  const std::size_t stride = grid.stride();
   orSerial(parallel).forRange(cells.size(), kSpreadChunk, [&](std::size_t k0, std::size_t k1) {
     for (std::size_t k = k0; k < k1; ++k)
     {
       if (k + kSpreadAhead < k1)
       {
         const std::size_t ahead = cells[k + kSpreadAhead];
-        for (int slot = 0; slot < MapMassGrid::kNumPlanes; ++slot) __builtin_prefetch(base + slot * stride + ahead, 1);
+        const float* block = base + MapMassGrid::blockOffset(ahead - ahead % MapMassGrid::kBlockCells);
+        for (std::size_t f = 0; f < MapMassGrid::kBlockFloats; f += kFloatsPerLine) __builtin_prefetch(block + f, 1);
         for (int e = 0; e < FrameMG::kSize; ++e) __builtin_prefetch(betp.p[e].data() + ahead, 1);
       }
       const std::size_t i = cells[k];
       float mass[kernels::kSubsets];
-      kernels::loadMasses(base, stride, i, mass);
+      kernels::loadMasses(base, i, mass);
       for (int a = 0; a < kernels::kSubsets; ++a)
         if ((a & FrameMG::kV) && a != FrameMG::kV && !(a & FrameMG::kF))
         {
@@ -614,7 +637,7 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
           mass[a] = 0.0f;
         }
       kernels::renormalise(mass);
-      kernels::storeMasses(base, stride, i, mass);
+      kernels::storeMasses(base, i, mass);
       float p[FrameMG::kSize];
       kernels::pignistic(mass, p);
       for (int e = 0; e < FrameMG::kSize; ++e) betp.p[e][i] = p[e];
@@ -737,6 +760,74 @@ void shiftPlane(float* p, const GridGeometry& g, int dx, int dy, float fill)
   }
 }
 
+/// The value a vacated cell takes in slot @p s (ζ: MapMassGrid::kNumPlanes): vacuous, ζ = 0.
+float vacatedValue(int s) { return s == MapMassGrid::slot(FrameMG::kOmega) ? 1.0f : 0.0f; }
+
+/// MapGrid::shift on any width, one cell after another: cell j takes cell j + dx + dy · width (linear in j), in the
+/// order that reads every source before it is overwritten.
+void shiftCells(MapMassGrid& grid, int dx, int dy)
+{
+  const GridGeometry& g = grid.geometry();
+  const std::ptrdiff_t d = dx + static_cast<std::ptrdiff_t>(dy) * g.width;
+  const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(g.numCells());
+  for (std::ptrdiff_t k = 0; k < n; ++k)
+  {
+    const std::ptrdiff_t j = d > 0 ? k : n - 1 - k;
+    const int x = static_cast<int>(j % g.width) + dx, y = static_cast<int>(j / g.width) + dy;
+    const bool inside = x >= 0 && x < g.width && y >= 0 && y < g.height;
+    const auto dst = static_cast<std::size_t>(j);
+    for (int s = 0; s <= MapMassGrid::kNumPlanes; ++s)
+      grid.value(s, dst) = inside ? grid.value(s, static_cast<std::size_t>(j + d)) : vacatedValue(s);
+  }
+}
+
+/// Rows of whole blocks: the rows move by dy in one memmove, then each row's cells by dx, rows in parallel, through
+/// @p tmp (per slot, the row between two rows of vacated values) so that eight cells move at a time.
+void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par)
+{
+  const GridGeometry& g = grid.geometry();
+  constexpr std::size_t kB = MapMassGrid::kBlockCells;
+  constexpr int kSlots = MapMassGrid::kNumPlanes + 1;
+  const std::size_t w = static_cast<std::size_t>(g.width), h = static_cast<std::size_t>(g.height);
+  const std::size_t row_floats = w / kB * MapMassGrid::kBlockFloats;
+  float* const data = grid.planes();
+  auto vacate_rows = [&](std::size_t y0, std::size_t y1) {
+    for (std::size_t b = y0 * w; b < y1 * w; b += kB)
+      for (int s = 0; s < kSlots; ++s) std::fill_n(data + MapMassGrid::blockOffset(b) + s * kB, kB, vacatedValue(s));
+  };
+  if (dy != 0)
+  {
+    const std::size_t moved = h - static_cast<std::size_t>(std::abs(dy));
+    const std::size_t from = dy > 0 ? static_cast<std::size_t>(dy) : 0, to = dy > 0 ? 0 : static_cast<std::size_t>(-dy);
+    std::memmove(data + to * row_floats, data + from * row_floats, moved * row_floats * sizeof(float));
+    if (dy > 0)
+      vacate_rows(moved, h);
+    else
+      vacate_rows(0, to);
+  }
+  if (dx == 0) return;
+  par.forRange(h, kShiftRows, [&](std::size_t y0, std::size_t y1) {
+    thread_local std::vector<float> tmp;
+    tmp.resize(kSlots * 3 * w);
+    for (int s = 0; s < kSlots; ++s)
+    {
+      std::fill_n(tmp.data() + s * 3 * w, w, vacatedValue(s));
+      std::fill_n(tmp.data() + s * 3 * w + 2 * w, w, vacatedValue(s));
+    }
+    for (std::size_t y = y0; y < y1; ++y)
+    {
+      float* const row = data + y * row_floats;
+      for (std::size_t x = 0; x < w; x += kB)
+        for (int s = 0; s < kSlots; ++s)
+          std::memcpy(tmp.data() + s * 3 * w + w + x, row + x / kB * MapMassGrid::kBlockFloats + s * kB, kB * sizeof(float));
+      for (std::size_t x = 0; x < w; x += kB)
+        for (int s = 0; s < kSlots; ++s)
+          std::memcpy(row + x / kB * MapMassGrid::kBlockFloats + s * kB,
+                      tmp.data() + s * 3 * w + w + static_cast<std::ptrdiff_t>(x) + dx, kB * sizeof(float));
+    }
+  });
+}
+
 }  // namespace
 
 void MapGrid::shift(int dx, int dy)
@@ -750,15 +841,11 @@ void MapGrid::shift(int dx, int dy)
     std::fill(map_doubt_.begin(), map_doubt_.end(), 0.0f);
     return;
   }
-  // Every plane (the masses, ζ and the map doubt) is its own chunk.
-  const bool doubt = map_doubt_.size() == g.numCells();
-  constexpr int kPlanes = MapMassGrid::kNumPlanes;
-  parallel_->forChunks(kPlanes + 1 + (doubt ? 1 : 0), [&](std::size_t c) {
-    const int plane = static_cast<int>(c);
-    float* p = plane == kPlanes + 1 ? map_doubt_.data()
-                                    : grid_.planes() + static_cast<std::size_t>(plane) * grid_.stride();
-    shiftPlane(p, g, dx, dy, plane == MapMassGrid::slot(FrameMG::kOmega) ? 1.0f : 0.0f);
-  });
+  if (g.width % static_cast<int>(MapMassGrid::kBlockCells) == 0)
+    shiftBlockRows(grid_, dx, dy, *parallel_);
+  else
+    shiftCells(grid_, dx, dy);
+  if (map_doubt_.size() == g.numCells()) shiftPlane(map_doubt_.data(), g, dx, dy, 0.0f);
 }
 
 void navigableLayer(const std::vector<std::int8_t>& decision, const PriorWindow& prior, std::vector<std::int8_t>& out)

@@ -83,6 +83,27 @@ core::GridGeometry GridConversions::fromMapMetaData(const nav_msgs::MapMetaData&
   return g;
 }
 
+namespace {
+
+/// Slot @p s of every cell of @p grid, appended to @p out (for either layout of MassGrid).
+template <class Frame>
+void appendSlot(const core::MassGrid<Frame>& grid, int s, std::vector<float>& out)
+{
+  const std::size_t n = grid.numCells(), first = out.size();
+  out.resize(first + n);
+  float* const dst = out.data() + first;
+  for (std::size_t i = 0; i < n; ++i) dst[i] = grid.value(s, i);
+}
+
+/// Slot @p s of every cell of @p grid from @p src (nullptr: zeros).
+template <class Frame>
+void writeSlot(core::MassGrid<Frame>& grid, int s, const float* src)
+{
+  for (std::size_t i = 0, n = grid.numCells(); i < n; ++i) grid.value(s, i) = src ? src[i] : 0.0f;
+}
+
+}  // namespace
+
 template <class Frame>
 void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msgs::Header& header,
                                 EvidentialGrid& msg, PlaneSelection planes, bool with_counter)
@@ -96,21 +117,16 @@ void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msg
   for (int a = 0; a < Frame::kNumSubsets; ++a)
   {
     if (!grid.stored(static_cast<Subset>(a))) continue;  // mass 0 in every cell
-    const float* p = grid.plane(static_cast<Subset>(a));
-    if (planes == PlaneSelection::kAll || std::any_of(p, p + n, [](float v) { return v != 0.0f; }))
-      msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
+    const int s = grid.slot(static_cast<Subset>(a));
+    bool any = planes == PlaneSelection::kAll;
+    for (std::size_t i = 0; i < n && !any; ++i) any = grid.value(s, i) != 0.0f;
+    if (any) msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
   }
   msg.masses.clear();  // appended plane by plane: no zero fill first
   msg.masses.reserve(msg.focal_sets.size() * n);
-  for (const std::uint8_t a : msg.focal_sets)
-  {
-    const float* p = grid.plane(a);
-    msg.masses.insert(msg.masses.end(), p, p + n);
-  }
-  if (with_counter)
-    msg.counter.assign(grid.counter(), grid.counter() + n);
-  else
-    msg.counter.clear();
+  for (const std::uint8_t a : msg.focal_sets) appendSlot(grid, grid.slot(a), msg.masses);
+  msg.counter.clear();
+  if (with_counter) appendSlot(grid, core::MassGrid<Frame>::kNumPlanes, msg.counter);
 }
 
 template <class Frame>
@@ -139,16 +155,13 @@ void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Fram
   }
   if (grid.geometry() != g)
     grid.reset(g);
-  for (int a = 0; a < Frame::kNumSubsets; ++a)  // each stored plane written once: copied, or zeros when absent
+  for (int a = 0; a < Frame::kNumSubsets; ++a)  // each stored slot written once: copied, or zeros when absent
     if (grid.stored(static_cast<Subset>(a)) && !(seen & (1ull << a)))
-      std::fill_n(grid.plane(static_cast<Subset>(a)), n, 0.0f);
+      writeSlot(grid, grid.slot(static_cast<Subset>(a)), nullptr);
   for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
     if (grid.stored(msg.focal_sets[k]))
-      std::copy_n(msg.masses.begin() + static_cast<std::ptrdiff_t>(k * n), n, grid.plane(msg.focal_sets[k]));
-  if (msg.counter.empty())
-    std::fill_n(grid.counter(), n, 0.0f);
-  else
-    std::copy(msg.counter.begin(), msg.counter.end(), grid.counter());
+      writeSlot(grid, grid.slot(msg.focal_sets[k]), msg.masses.data() + k * n);
+  writeSlot(grid, core::MassGrid<Frame>::kNumPlanes, msg.counter.empty() ? nullptr : msg.counter.data());
 }
 
 template void GridConversions::toMessage(const core::MassGrid<FrameMG>&, const std_msgs::Header&, EvidentialGrid&,
@@ -211,10 +224,10 @@ void GridConversions::pignisticToOccupancy(const core::MapMassGrid& grid, const 
   if (element < 0 || element >= FrameMG::kSize)
     throw ConversionError("pignisticToOccupancy: element " + std::to_string(element) + " is not in the frame");
   fillHeader(header, grid.geometry(), out);
-  const float* omega = grid.plane(FrameMG::kOmega);
   const auto& p = betp[element];
+  const int omega = core::MapMassGrid::slot(FrameMG::kOmega);
   for (std::size_t i = 0; i < grid.numCells(); ++i)
-    out.data[i] = omega[i] >= 1.0f - vacuous_tolerance ? kUnknownOccupancy : toOccupancyValue(p[i]);
+    out.data[i] = grid.value(omega, i) >= 1.0f - vacuous_tolerance ? kUnknownOccupancy : toOccupancyValue(p[i]);
 }
 
 void GridConversions::scanToOccupancy(const core::ScanMassGrid& grid, const std_msgs::Header& header,

@@ -27,7 +27,7 @@ MapMassGrid randomMapGrid(std::mt19937& rng, const GridGeometry& g, bool with_co
   for (std::size_t i = 0; i < grid.numCells(); ++i)
   {
     grid.setCell(i, randomMass<FrameMG>(rng, 8, false, true));
-    if (with_counter) grid.counter()[i] = static_cast<float>(u(rng));
+    if (with_counter) grid.zeta(i) = static_cast<float>(u(rng));
   }
   return grid;
 }
@@ -104,33 +104,49 @@ TEST(GridGeometry, WorldCellRoundTripAndRowMajorIndex)
   EXPECT_THROW((GridGeometry{ 0.5, 0, 10, 0, 0 }.validate()), ParameterError);
 }
 
-TEST(MassGrid, PlanesAreAlignedAndStartVacuous)
+TEST(MassGrid, MapGridBlocksInterleaveEverySlotAndStartVacuous)
 {
   MapMassGrid grid(testGeometry());
   EXPECT_EQ(MapMassGrid::kNumPlanes, 29) << "the reachable focal sets (ReachableFocalSets)";
   EXPECT_EQ(ScanMassGrid::kNumPlanes, 4);
+  EXPECT_EQ(MapMassGrid::kBlockCells, 8u);
+  EXPECT_EQ(MapMassGrid::kBlockFloats, 8u * 30u) << "29 masses and zeta per cell";
+  EXPECT_EQ(grid.stride(), 8u);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.planes()) % 64, 0u);
+  EXPECT_EQ(MapMassGrid::kBlockFloats * sizeof(float) % 64, 0u) << "every block starts on a cache line";
+  const std::size_t n = grid.numCells();
+  EXPECT_EQ(grid.bytes(), (n + 7) / 8 * 240 * sizeof(float)) << "whole blocks: the last one padded";
   int slots = 0;
   for (int a = 0; a < 32; ++a)
   {
     if (!MapMassGrid::stored(static_cast<Subset>(a)))
     {
-      EXPECT_THROW(grid.plane(static_cast<Subset>(a)), std::out_of_range) << a;
+      EXPECT_THROW(grid.at(static_cast<Subset>(a), 0), std::out_of_range) << a;
       continue;
     }
-    EXPECT_EQ(MapMassGrid::slot(static_cast<Subset>(a)), slots++);
-    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.plane(static_cast<Subset>(a))) % 64, 0u);
+    const int s = slots++;
+    EXPECT_EQ(MapMassGrid::slot(static_cast<Subset>(a)), s);
+    for (std::size_t i : { std::size_t{ 0 }, std::size_t{ 7 }, std::size_t{ 8 }, std::size_t{ 13 }, n - 1 })
+      EXPECT_EQ(&grid.at(static_cast<Subset>(a), i), grid.planes() + (i / 8) * 240 + s * 8 + i % 8) << a << " " << i;
   }
+  for (std::size_t i : { std::size_t{ 0 }, std::size_t{ 9 }, n - 1 })
+    EXPECT_EQ(&grid.zeta(i), grid.planes() + (i / 8) * 240 + 29 * 8 + i % 8) << i;
   EXPECT_FALSE(MapMassGrid::stored(0));
   EXPECT_FALSE(MapMassGrid::stored(FrameMG::kC | FrameMG::kV));
   EXPECT_FALSE(MapMassGrid::stored(FrameMG::kF | FrameMG::kC | FrameMG::kV));
-  EXPECT_EQ(grid.bytes(), grid.stride() * 30 * sizeof(float)) << "29 mass planes and zeta";
   EXPECT_THROW(grid.setCell(0, MassMG{ { FrameMG::kC | FrameMG::kV, 0.5 }, { FrameMG::kOmega, 0.5 } }),
                std::invalid_argument);
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grid.counter()) % 64, 0u);
-  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  for (std::size_t i = 0; i < n; ++i)
   {
     EXPECT_TRUE(massNear(grid.cell(i), MassMG::vacuous(), 0.0));
-    EXPECT_EQ(grid.counter()[i], 0.0f);
+    EXPECT_EQ(grid.zeta(i), 0.0f);
+  }
+  // A ScanGrid stays planar: one aligned plane per subset.
+  ScanMassGrid scan(testGeometry());
+  for (int a = 0; a < 4; ++a)
+  {
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(scan.plane(static_cast<Subset>(a))) % 64, 0u);
+    EXPECT_EQ(&scan.at(static_cast<Subset>(a), 5), scan.plane(static_cast<Subset>(a)) + 5);
   }
 }
 
@@ -213,8 +229,8 @@ TEST(GridOps, CounterAndSpecialisationMatchScalar)
     {
       const auto m = before.cell(i);
       const double zeta =
-          updateCounter(before.counter()[i], m.massInside(FrameMG::kO), ConflictMasses{ fo[i], of[i], 0.0 }, p);
-      ASSERT_NEAR(grid.counter()[i], zeta, 1e-6) << "cell " << i;
+          updateCounter(before.zeta(i), m.massInside(FrameMG::kO), ConflictMasses{ fo[i], of[i], 0.0 }, p);
+      ASSERT_NEAR(grid.zeta(i), zeta, 1e-6) << "cell " << i;
       ASSERT_TRUE(massNear(grid.cell(i), specialise(m, zeta, mode), kFloatTolerance)) << "cell " << i;
     }
   }
@@ -267,13 +283,13 @@ TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
       double sum_fo = 0, sum_of = 0, sum_other = 0;
       for (std::size_t i = 0; i < map.numCells(); ++i)
       {
-        const auto ref = fuseCell(before.cell(i), before.counter()[i], scan.cell(i),
+        const auto ref = fuseCell(before.cell(i), before.zeta(i), scan.cell(i),
                                   with_prior ? prior.cell(i) : MassMG::vacuous(), params);
         ASSERT_TRUE(massNear(map.cell(i), ref.mass, kFloatTolerance)) << "cell " << i;
-        ASSERT_NEAR(map.counter()[i], ref.zeta, 1e-6) << "cell " << i;
+        ASSERT_NEAR(map.zeta(i), ref.zeta, 1e-6) << "cell " << i;
         ASSERT_TRUE(isValidMass(map.cell(i), kFloatTolerance));
         ASSERT_TRUE(massNear(staged.cell(i), map.cell(i), kFloatTolerance)) << "cell " << i;
-        ASSERT_NEAR(staged.counter()[i], map.counter()[i], 1e-6);
+        ASSERT_NEAR(staged.zeta(i), map.zeta(i), 1e-6);
         sum_fo += ref.conflicts.free_occupied;
         sum_of += ref.conflicts.occupied_free;
         sum_other += ref.conflicts.other;
@@ -311,9 +327,9 @@ TEST(FusionStep, AblationVariantsMatchTheScalarReference)
     fusionStep(map, scan, &prior, params);
     for (std::size_t i = 0; i < map.numCells(); ++i)
     {
-      const auto ref = fuseCell(before.cell(i), before.counter()[i], scan.cell(i), prior.cell(i), params);
+      const auto ref = fuseCell(before.cell(i), before.zeta(i), scan.cell(i), prior.cell(i), params);
       ASSERT_TRUE(massNear(map.cell(i), ref.mass, kFloatTolerance)) << "cell " << i;
-      ASSERT_NEAR(map.counter()[i], ref.zeta, 1e-6);
+      ASSERT_NEAR(map.zeta(i), ref.zeta, 1e-6);
       ASSERT_TRUE(isValidMass(map.cell(i), kFloatTolerance));
     }
   }

@@ -99,21 +99,29 @@ MapGridParams defaultParams()
 
 }  // namespace
 
-TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
+class MapGridShift : public ::testing::TestWithParam<double>
+{
+};
+
+// Widths of 40 cells (rows of whole blocks: rows moved as blocks) and 41 (the cell-by-cell path).
+INSTANTIATE_TEST_SUITE_P(BlockRowsAndAnyWidth, MapGridShift, ::testing::Values(20.0, 20.5));
+
+TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
 {
   MapGridParams params = defaultParams();
-  params.size_x = 20.0;
+  params.size_x = GetParam();
   params.size_y = 15.0;
   MapGrid mg(params);
+  ASSERT_EQ(mg.geometry().width % 8 == 0, GetParam() == 20.0);
   std::mt19937 rng(3);
   auto& grid = mg.masses();
   for (std::size_t i = 0; i < grid.numCells(); ++i)
   {
     grid.setCell(i, maf_test::randomMass<FrameMG>(rng, 6, false, true));
-    grid.counter()[i] = static_cast<float>(i % 17) / 17.0f;
+    grid.zeta(i) = static_cast<float>(i % 17) / 17.0f;
   }
   const MapMassGrid before = grid;
-  for (auto [dx, dy] : { std::pair{ 3, -2 }, std::pair{ -5, 0 }, std::pair{ 0, 4 }, std::pair{ 1, 1 } })
+  for (auto [dx, dy] : { std::pair{ 3, -2 }, std::pair{ -5, 0 }, std::pair{ 0, 4 }, std::pair{ 1, 1 }, std::pair{ -16, 3 } })
   {
     MapGrid moved = mg;
     moved.shift(dx, dy);
@@ -131,9 +139,9 @@ TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
           for (int a = 0; a < 32; ++a)
             if (MapMassGrid::stored(static_cast<Subset>(a)))
             {
-              ASSERT_EQ(moved.masses().plane(static_cast<Subset>(a))[j], before.plane(static_cast<Subset>(a))[i]);
+              ASSERT_EQ(moved.masses().at(static_cast<Subset>(a), j), before.at(static_cast<Subset>(a), i));
             }
-          ASSERT_EQ(moved.masses().counter()[j], before.counter()[i]);
+          ASSERT_EQ(moved.masses().zeta(j), before.zeta(i));
           // Same world position before and after.
           const Point2 pw = g.cellCentre(CellIndex{ x, y });
           const Point2 pb = before.geometry().cellCentre(src);
@@ -143,7 +151,7 @@ TEST(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
         else
         {
           ASSERT_TRUE(maf_test::massNear(moved.masses().cell(j), MassMG::vacuous(), 0.0));
-          ASSERT_EQ(moved.masses().counter()[j], 0.0f);
+          ASSERT_EQ(moved.masses().zeta(j), 0.0f);
         }
       }
   }
@@ -202,7 +210,7 @@ TEST(ProjectScan, IdentityIsAnExactCopyAndRotationLosesNoObstacle)
   ScanMassGrid out;
   projectScan(scan, Pose2{ 0.0, 0.0, 0.0 }, sg, out);
   for (std::size_t i = 0; i < scan.numCells(); ++i)
-    for (int a = 0; a < 4; ++a) ASSERT_EQ(out.plane(static_cast<Subset>(a))[i], scan.plane(static_cast<Subset>(a))[i]);
+    for (int a = 0; a < 4; ++a) ASSERT_EQ(out.at(static_cast<Subset>(a), i), scan.at(static_cast<Subset>(a), i));
 
   // A window translated by whole cells and a vehicle away from the origin: still a copy.
   auto window = sg;
@@ -227,7 +235,7 @@ TEST(ProjectScan, IdentityIsAnExactCopyAndRotationLosesNoObstacle)
     pole.setCell(k, kOccupiedScan);
     projectScan(pole, Pose2{ 1.3, -0.7, yaw }, GridGeometry::centred(40.0, 40.0, kRes), out);
     int occupied = 0;
-    for (std::size_t i = 0; i < out.numCells(); ++i) occupied += out.plane(FrameSG::kO)[i] > 0.0f;
+    for (std::size_t i = 0; i < out.numCells(); ++i) occupied += out.at(FrameSG::kO, i) > 0.0f;
     EXPECT_GE(occupied, 1) << "yaw " << yaw;
   }
 }
@@ -273,13 +281,13 @@ TEST(ProjectScan, ClearanceTakesTheFreeMassWithinTheSquareOfEveryObstacle)
             bool near = false;
             for (int yy = std::max(0, y - k); yy <= std::min(window.height - 1, y + k) && !near; ++yy)
               for (int xx = std::max(0, x - k); xx <= std::min(window.width - 1, x + k) && !near; ++xx)
-                near = plain.plane(FrameSG::kO)[window.index(xx, yy)] > 0.0f;
+                near = plain.at(FrameSG::kO, window.index(xx, yy)) > 0.0f;
             const std::size_t j = window.index(x, y);
-            const float f = plain.plane(FrameSG::kF)[j], w = plain.plane(FrameSG::kOmega)[j];
+            const float f = plain.at(FrameSG::kF, j), w = plain.at(FrameSG::kOmega, j);
             near_obstacle += near && f > 0.0f;
-            mismatches += cleared.plane(FrameSG::kF)[j] != (near ? 0.0f : f) ||
-                          cleared.plane(FrameSG::kOmega)[j] != (near ? w + f : w) ||
-                          cleared.plane(FrameSG::kO)[j] != plain.plane(FrameSG::kO)[j];
+            mismatches += cleared.at(FrameSG::kF, j) != (near ? 0.0f : f) ||
+                          cleared.at(FrameSG::kOmega, j) != (near ? w + f : w) ||
+                          cleared.at(FrameSG::kO, j) != plain.at(FrameSG::kO, j);
           }
         EXPECT_GT(near_obstacle, 50u) << "k " << k << " yaw " << yaw;
         EXPECT_EQ(mismatches, 0u) << "k " << k << " yaw " << yaw << (obstacles ? " with points" : "");
@@ -501,10 +509,10 @@ TEST(MapGrid, RatesPerSecondForgetByElapsedTime)
   const std::size_t k = b.geometry().index(b.geometry().cellAt(Point2{ 2.25, 2.25 }));
   FusionParams two_seconds = p.fusion;
   two_seconds.discount = p.fusion.discount.compounded(2.0);
-  const auto expected = fuseCell(b.masses().cell(k), b.masses().counter()[k], MassSG::vacuous(), MassMG::vacuous(),
+  const auto expected = fuseCell(b.masses().cell(k), b.masses().zeta(k), MassSG::vacuous(), MassMG::vacuous(),
                                  two_seconds);
   EXPECT_TRUE(maf_test::massNear(a.masses().cell(k), expected.mass, 1e-5));
-  const auto per_scan = fuseCell(b.masses().cell(k), b.masses().counter()[k], MassSG::vacuous(), MassMG::vacuous(),
+  const auto per_scan = fuseCell(b.masses().cell(k), b.masses().zeta(k), MassSG::vacuous(), MassMG::vacuous(),
                                  p.fusion);
   EXPECT_FALSE(maf_test::massNear(a.masses().cell(k), per_scan.mass, 1e-3)) << "2 s must forget more than one scan";
 }

@@ -258,9 +258,9 @@ TEST(MotionSteps, MotionMarginDecidesOccupiedWhenSAndVAreClose)
   const float sv[3][3] = { { 0.0f, 0.8f, 0.0f }, { 0.05f, 0.75f, 0.0f }, { 0.5f, 0.3f, 0.0f } };  // {S}, {S,V}, {V}
   for (int i = 0; i < 3; ++i)
   {
-    g.plane(FrameMG::kS)[i] = sv[i][0];
-    g.plane(FrameMG::kS | FrameMG::kV)[i] = sv[i][1];
-    g.plane(FrameMG::kOmega)[i] = 1.0f - sv[i][0] - sv[i][1];
+    g.at(FrameMG::kS, i) = sv[i][0];
+    g.at(FrameMG::kS | FrameMG::kV, i) = sv[i][1];
+    g.at(FrameMG::kOmega, i) = 1.0f - sv[i][0] - sv[i][1];
   }
   PignisticPlanes betp;
   pignisticGrid(g, betp);
@@ -284,10 +284,10 @@ TEST(MotionSteps, MotionSpreadingMakesASmallRegionWithVCellsMovingAndLeavesLarge
   scan.fillVacuous();
   auto occupy = [&](int x, int y, Subset a) {
     const std::size_t i = geo.index(x, y);
-    g.plane(a)[i] = 0.8f;
-    g.plane(FrameMG::kOmega)[i] = 0.2f;
-    scan.plane(FrameSG::kO)[i] = 0.8f;
-    scan.plane(FrameSG::kOmega)[i] = 0.2f;
+    g.at(a, i) = 0.8f;
+    g.at(FrameMG::kOmega, i) = 0.2f;
+    scan.at(FrameSG::kO, i) = 0.8f;
+    scan.at(FrameSG::kOmega, i) = 0.2f;
   };
   // A 4-cell object: one V cell, three open {C, N, S, V}; a separate 12-cell region with one V cell.
   occupy(0, 0, FrameMG::kV);
@@ -297,8 +297,8 @@ TEST(MotionSteps, MotionSpreadingMakesASmallRegionWithVCellsMovingAndLeavesLarge
   PignisticPlanes betp;
   pignisticGrid(g, betp);
   EXPECT_EQ(spreadMotion(g, betp, scan, 0.2, 200, 0.4, 0.1), 1u);
-  for (int x = 0; x < 4; ++x) EXPECT_FLOAT_EQ(g.plane(FrameMG::kV)[geo.index(x, 0)], 0.8f) << x;
-  for (int x = 9; x < 20; ++x) EXPECT_FLOAT_EQ(g.plane(FrameMG::kO)[geo.index(x, 2)], 0.8f) << x;
+  for (int x = 0; x < 4; ++x) EXPECT_FLOAT_EQ(g.at(FrameMG::kV, geo.index(x, 0)), 0.8f) << x;
+  for (int x = 9; x < 20; ++x) EXPECT_FLOAT_EQ(g.at(FrameMG::kO, geo.index(x, 2)), 0.8f) << x;
   for (std::size_t i = 0; i < geo.numCells(); ++i)
   {
     double sum = 0.0;

@@ -129,10 +129,7 @@ DriveResult drive(int threads)
     r.conflicts.push_back(s.sum_conflict_other);
   }
   const MapMassGrid& m = grid.masses();
-  for (int a = 0; a < FrameMG::kNumSubsets; ++a)
-    if (MapMassGrid::stored(static_cast<Subset>(a)))
-      r.planes.insert(r.planes.end(), m.plane(static_cast<Subset>(a)), m.plane(static_cast<Subset>(a)) + m.numCells());
-  r.planes.insert(r.planes.end(), m.counter(), m.counter() + m.numCells());
+  r.planes.assign(m.planes(), m.planes() + m.bytes() / sizeof(float));  // every slot of every cell, and ζ
   for (int e = 0; e < FrameMG::kSize; ++e)
     r.betp.insert(r.betp.end(), grid.pignistic()[e].begin(), grid.pignistic()[e].end());
   r.doubt.assign(grid.mapDoubt().begin(), grid.mapDoubt().end());
@@ -182,10 +179,10 @@ TEST(Parallel, MotionSpreadingOverManyChunksIsBitIdenticalForAnyThreadCount)
       for (int k = 0; k < 4; ++k)
       {
         const std::size_t i = geo.index(x + k, y);
-        start.plane(k == 0 ? FrameMG::kV : FrameMG::kO)[i] = 0.8f;
-        start.plane(FrameMG::kOmega)[i] = 0.2f;
-        scan.plane(FrameSG::kO)[i] = 0.8f;
-        scan.plane(FrameSG::kOmega)[i] = 0.2f;
+        start.at(k == 0 ? FrameMG::kV : FrameMG::kO, i) = 0.8f;
+        start.at(FrameMG::kOmega, i) = 0.2f;
+        scan.at(FrameSG::kO, i) = 0.8f;
+        scan.at(FrameSG::kOmega, i) = 0.2f;
       }
   std::vector<float> first_planes, first_betp;
   for (int threads : { 1, 2, 4 })
@@ -195,8 +192,8 @@ TEST(Parallel, MotionSpreadingOverManyChunksIsBitIdenticalForAnyThreadCount)
     PignisticPlanes betp;
     pignisticGrid(g, betp);
     EXPECT_EQ(spreadMotion(g, betp, scan, 0.2, 200, 0.4, 0.1, &parallel), objects) << threads;
-    EXPECT_FLOAT_EQ(g.plane(FrameMG::kV)[geo.index(3, 0)], 0.8f) << "an open cell became V, " << threads;
-    std::vector<float> planes(g.planes(), g.planes() + g.stride() * MapMassGrid::kNumPlanes), p;
+    EXPECT_FLOAT_EQ(g.at(FrameMG::kV, geo.index(3, 0)), 0.8f) << "an open cell became V, " << threads;
+    std::vector<float> planes(g.planes(), g.planes() + g.bytes() / sizeof(float)), p;
     for (int e = 0; e < FrameMG::kSize; ++e) p.insert(p.end(), betp[e].begin(), betp[e].end());
     if (threads == 1)
     {

@@ -247,10 +247,10 @@ TEST(Soak, HundredThousandNoisyScansKeepMassFunctionsAndFlatMemory)
     {
       // Noisy sensor: free, occupied or unknown with random confidence, then m(Ω) the rest.
       const float f = u(rng), o = u(rng) * (1.0f - f);
-      scan.plane(FrameSG::kF)[i] = f;
-      scan.plane(FrameSG::kO)[i] = o;
-      scan.plane(FrameSG::kOmega)[i] = 1.0f - f - o;
-      scan.plane(0)[i] = 0.0f;
+      scan.at(FrameSG::kF, i) = f;
+      scan.at(FrameSG::kO, i) = o;
+      scan.at(FrameSG::kOmega, i) = 1.0f - f - o;
+      scan.at(0, i) = 0.0f;
     }
     const Pose2 pose{ 10.0 * std::sin(1e-3 * k), 10.0 * std::cos(1.3e-3 * k), 1e-2 * k };
     grid.update(scan, pose, 0.1 * (k + 1), &prior);
@@ -269,8 +269,8 @@ TEST(Soak, HundredThousandNoisyScansKeepMassFunctionsAndFlatMemory)
           sum += v;
         }
         worst_sum = std::max(worst_sum, std::abs(sum - 1.0));
-        zeta_min = std::min(zeta_min, m.counter()[i]);
-        zeta_max = std::max(zeta_max, m.counter()[i]);
+        zeta_min = std::min(zeta_min, m.zeta(i));
+        zeta_max = std::max(zeta_max, m.zeta(i));
       }
     }
   }

@@ -27,7 +27,7 @@ MapMassGrid randomGrid(std::mt19937& rng)
   for (std::size_t i = 0; i < g.numCells(); ++i)
   {
     g.setCell(i, maf_test::randomMass<FrameMG>(rng, 4, false, true));
-    g.counter()[i] = static_cast<float>(i) / g.numCells();
+    g.zeta(i) = static_cast<float>(i) / g.numCells();
   }
   return g;
 }
@@ -74,9 +74,9 @@ TEST(Conversions, EvidentialGridRoundTripIsExact)
       for (int a = 0; a < 32; ++a)
         if (MapMassGrid::stored(static_cast<Subset>(a)))
         {
-          ASSERT_EQ(back.plane(static_cast<Subset>(a))[i], grid.plane(static_cast<Subset>(a))[i]);
+          ASSERT_EQ(back.at(static_cast<Subset>(a), i), grid.at(static_cast<Subset>(a), i));
         }
-      ASSERT_EQ(back.counter()[i], grid.counter()[i]);
+      ASSERT_EQ(back.zeta(i), grid.zeta(i));
     }
   }
 }
@@ -93,7 +93,7 @@ TEST(Conversions, ScanGridRoundTrip)
   ScanMassGrid back;
   GridConversions::fromMessage(msg, back);
   for (std::size_t i = 0; i < grid.numCells(); ++i)
-    for (int a = 0; a < 4; ++a) ASSERT_EQ(back.plane(static_cast<Subset>(a))[i], grid.plane(static_cast<Subset>(a))[i]);
+    for (int a = 0; a < 4; ++a) ASSERT_EQ(back.at(static_cast<Subset>(a), i), grid.at(static_cast<Subset>(a), i));
 }
 
 TEST(Conversions, MalformedMessagesAreRejectedWithReasons)

@@ -1,8 +1,8 @@
 /**
  * @file mass_grid.hpp
- * @brief Evidential grids stored as structure-of-arrays: one contiguous float plane per stored subset of the
- *        frame plus a plane for the counter ζ. A ScanGrid stores its four subsets; the MapGrid stores only the 29
- *        focal sets its pipeline can reach (PlaneLayout).
+ * @brief Evidential grids: for every cell, a float per stored subset of the frame and one for the counter ζ. A
+ *        ScanGrid stores its four subsets as planes (one contiguous array per subset); the MapGrid stores only the
+ *        29 focal sets its pipeline can reach (PlaneLayout), interleaved in blocks of eight cells.
  */
 #pragma once
 
@@ -25,11 +25,14 @@ constexpr std::size_t kPlaneAlignmentFloats = 16;
 /// share a cache set (a page-multiple stride makes some 40 streams fight over the same sets).
 constexpr std::size_t kPlanePageFloats = 1024;
 
-/// Which subsets of @p Frame a MassGrid stores: every one, by default.
+/// Which subsets of @p Frame a MassGrid stores (every one, by default) and how: kBlockCells = 0 is one plane per
+/// subset; kBlockCells = k interleaves the grid in blocks of k consecutive cells, each block holding, slot after slot,
+/// the k values of every stored subset and then ζ.
 template <class Frame>
 struct PlaneLayout
 {
   static constexpr bool stored(Subset) { return true; }
+  static constexpr std::size_t kBlockCells = 0;
 };
 
 /**
@@ -45,12 +48,17 @@ struct PlaneLayout<FrameMG>
   {
     return a != 0 && a != (FrameMG::kC | FrameMG::kV) && a != (FrameMG::kF | FrameMG::kC | FrameMG::kV);
   }
+  /// Blocks of eight cells (one AVX vector per subset): the per-scan step reads and writes one contiguous stream
+  /// instead of 30 planes, which hardware prefetchers follow and which needs one address register, not 30.
+  static constexpr std::size_t kBlockCells = 8;
 };
 
 /**
- * @brief A grid of mass functions on @p Frame. Each stored subset a has a plane (slot(a)) holding m(a) for every
- *        cell, row-major; the plane after the last slot holds the counter ζ (used by the MapGrid, zero elsewhere).
- *        A subset that is not stored has mass 0 in every cell.
+ * @brief A grid of mass functions on @p Frame, cells row-major. Each stored subset a has a slot (slot(a)); the slot
+ *        after the last holds the counter ζ (used by the MapGrid, zero elsewhere). A subset that is not stored has
+ *        mass 0 in every cell. The value of slot s of cell i is planes()[offset(i) + s · stride()]: planar layouts
+ *        (offset(i) = i, stride() = the plane length) also give each slot as a plane (plane(), counter());
+ *        interleaved ones (PlaneLayout::kBlockCells) are read and written through at(), zeta() and value().
  */
 template <class Frame>
 class MassGrid
@@ -75,6 +83,16 @@ public:
   static constexpr bool stored(Subset a) { return PlaneLayout<Frame>::stored(a); }
   /// The plane index of a stored subset.
   static constexpr int slot(Subset a) { return kSlots[a]; }
+  /// Cells per interleaved block; 0 for a planar grid.
+  static constexpr std::size_t kBlockCells = PlaneLayout<Frame>::kBlockCells;
+  static constexpr bool kInterleaved = kBlockCells > 0;
+  /// Floats of one interleaved block: kBlockCells values of every slot and of ζ.
+  static constexpr std::size_t kBlockFloats = kBlockCells * (kNumPlanes + 1);
+  /// Where cell @p i of an interleaved grid starts (its slot s is kBlockCells · s further).
+  static constexpr std::size_t blockOffset(std::size_t i)
+  {
+    return kInterleaved ? i / kBlockCells * kBlockFloats + i % kBlockCells : i;
+  }
 
   MassGrid() = default;
   /// A vacuous grid (m(Ω) = 1, ζ = 0) of the given geometry.
@@ -85,8 +103,16 @@ public:
   {
     geometry_ = geometry;
     const std::size_t n = geometry.numCells();
-    stride_ = (n + kPlanePageFloats - 1) / kPlanePageFloats * kPlanePageFloats + kPlaneAlignmentFloats;
-    data_.assign(stride_ * (kNumPlanes + 1), 0.0f);
+    if (kInterleaved)
+    {
+      stride_ = kBlockCells;
+      data_.assign((n + kBlockCells - 1) / kBlockCells * kBlockFloats, 0.0f);
+    }
+    else
+    {
+      stride_ = (n + kPlanePageFloats - 1) / kPlanePageFloats * kPlanePageFloats + kPlaneAlignmentFloats;
+      data_.assign(stride_ * (kNumPlanes + 1), 0.0f);
+    }
     fillVacuous();
   }
 
@@ -94,7 +120,11 @@ public:
   void fillVacuous()
   {
     std::fill(data_.begin(), data_.end(), 0.0f);
-    std::fill_n(plane(Frame::kOmega), stride_, 1.0f);
+    const std::size_t omega = stride_ * static_cast<std::size_t>(checkedSlot(Frame::kOmega));
+    if (kInterleaved)
+      for (std::size_t b = 0; b < data_.size(); b += kBlockFloats) std::fill_n(data_.data() + b + omega, kBlockCells, 1.0f);
+    else
+      std::fill_n(data_.data() + omega, stride_, 1.0f);
   }
 
   const GridGeometry& geometry() const { return geometry_; }
@@ -105,24 +135,53 @@ public:
     geometry_.origin_y = origin_y;
   }
   std::size_t numCells() const { return geometry_.numCells(); }
-  /// Distance in floats between two consecutive planes.
+  /// Distance in floats between two consecutive slots of one cell: the plane length of a planar grid,
+  /// kBlockCells of an interleaved one.
   std::size_t stride() const { return stride_; }
+  /// Where cell @p i starts: its slot s is stride() · s further.
+  std::size_t offset(std::size_t i) const { return blockOffset(i); }
 
-  /// The plane of subset @p a. @throws std::out_of_range when @p a is not stored.
-  float* plane(Subset a) { return data_.data() + stride_ * checkedSlot(a); }
-  const float* plane(Subset a) const { return data_.data() + stride_ * checkedSlot(a); }
-  /// The first plane (slot 0); plane k is k · stride() floats further.
+  /// The plane of subset @p a (planar layouts only). @throws std::out_of_range when @p a is not stored.
+  float* plane(Subset a)
+  {
+    static_assert(!kInterleaved, "an interleaved grid has no planes: use at() or value()");
+    return data_.data() + stride_ * checkedSlot(a);
+  }
+  const float* plane(Subset a) const
+  {
+    static_assert(!kInterleaved, "an interleaved grid has no planes: use at() or value()");
+    return data_.data() + stride_ * checkedSlot(a);
+  }
+  /// The first float of the grid (see the class comment for the address of a value).
   float* planes() { return data_.data(); }
   const float* planes() const { return data_.data(); }
-  float* counter() { return data_.data() + stride_ * kNumPlanes; }
-  const float* counter() const { return data_.data() + stride_ * kNumPlanes; }
+  /// ζ as a plane (planar layouts only).
+  float* counter()
+  {
+    static_assert(!kInterleaved, "an interleaved grid has no planes: use zeta()");
+    return data_.data() + stride_ * kNumPlanes;
+  }
+  const float* counter() const
+  {
+    static_assert(!kInterleaved, "an interleaved grid has no planes: use zeta()");
+    return data_.data() + stride_ * kNumPlanes;
+  }
+  /// Slot @p s (kNumPlanes: ζ) of cell @p i.
+  float& value(int s, std::size_t i) { return data_[offset(i) + stride_ * static_cast<std::size_t>(s)]; }
+  float value(int s, std::size_t i) const { return data_[offset(i) + stride_ * static_cast<std::size_t>(s)]; }
+  /// m(@p a) of cell @p i. @throws std::out_of_range when @p a is not stored.
+  float& at(Subset a, std::size_t i) { return value(static_cast<int>(checkedSlot(a)), i); }
+  float at(Subset a, std::size_t i) const { return value(static_cast<int>(checkedSlot(a)), i); }
+  /// ζ of cell @p i.
+  float& zeta(std::size_t i) { return value(kNumPlanes, i); }
+  float zeta(std::size_t i) const { return value(kNumPlanes, i); }
 
   /// The mass function of cell @p i, in double.
   MassFunction<Frame> cell(std::size_t i) const
   {
     typename MassFunction<Frame>::Values v{};
     for (int a = 0; a < Frame::kNumSubsets; ++a)
-      if (kSlots[a] >= 0) v[a] = data_[stride_ * kSlots[a] + i];
+      if (kSlots[a] >= 0) v[a] = value(kSlots[a], i);
     return MassFunction<Frame>::fromValues(v);
   }
 
@@ -134,10 +193,10 @@ public:
         throw std::invalid_argument("MassGrid::setCell: mass on " + subsetName<Frame>(static_cast<Subset>(a)) +
                                     ", a subset this grid does not store");
     for (int a = 0; a < Frame::kNumSubsets; ++a)
-      if (kSlots[a] >= 0) data_[stride_ * kSlots[a] + i] = static_cast<float>(m[a]);
+      if (kSlots[a] >= 0) value(kSlots[a], i) = static_cast<float>(m[a]);
   }
 
-  /// Bytes of cell storage (all planes and the counter).
+  /// Bytes of cell storage (every slot and the counter).
   std::size_t bytes() const { return data_.size() * sizeof(float); }
 
 private:
