@@ -529,35 +529,32 @@ void decideCells(const float* __restrict omega, const float* const* p, float t, 
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double threshold, std::vector<std::int8_t>& out,
             const Parallel* parallel)
 {
-  const std::size_t n = grid.numCells();
-  out.resize(n);
-  const Parallel& par = orSerial(parallel);
-  const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
-  const float t = static_cast<float>(threshold);
-  std::int8_t* const d = out.data();
-  par.forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
-    float* const omega = omegaBuffer();
-    gatherOmega(grid, i0, i1, omega);
-    decideCells(omega, p, t, d, i0, i1);
-  });
+  MapGridParams params;
+  params.decision_threshold = threshold;
+  params.motion_margin = 0.0;
+  decide(grid, betp, params, out, parallel);
 }
 
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
             std::vector<std::int8_t>& out, const Parallel* parallel)
 {
-  decide(grid, betp, params.decision_threshold, out, parallel);
-  if (params.motion_margin <= 0.0) return;
+  const std::size_t n = grid.numCells();
+  out.resize(n);
+  const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
+  const float t = static_cast<float>(params.decision_threshold);
   const float margin = static_cast<float>(params.motion_margin);
   const float* ps = betp[FrameMG::kSize - 2].data();
   const float* pv = betp[FrameMG::kSize - 1].data();
-  const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
   const float* pf = betp[0].data();
-  const float t = static_cast<float>(params.decision_threshold);
+  const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
   const auto unknown = static_cast<std::int8_t>(CellClass::kUnknown);
   std::int8_t* const d = out.data();
-  orSerial(parallel).forRange(out.size(), kCellChunk, [&](std::size_t i0, std::size_t i1) {
+  // One copy of each chunk's m(Ω) out of the blocks serves both passes.
+  orSerial(parallel).forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
     float* const omega = omegaBuffer();
     gatherOmega(grid, i0, i1, omega);
+    decideCells(omega, p, t, d, i0, i1);
+    if (params.motion_margin <= 0.0) return;
     for (std::size_t i = i0; i < i1; ++i)
     {
       const bool tie = (d[i] == stopped || d[i] == moving) && std::abs(ps[i] - pv[i]) < margin;

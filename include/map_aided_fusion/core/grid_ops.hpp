@@ -1,8 +1,8 @@
 /**
  * @file grid_ops.hpp
  * @brief Whole-grid operations of the paper, one stage at a time (fusionStep() in fusion.hpp fuses
- *        them in one pass). Every function loops over cells with the planes as contiguous float
- *        arrays so that the compiler vectorises across cells.
+ *        them in one pass). Every function loops over cells, eight at a time (one block of the MapGrid, one
+ *        plane segment of the ScanGrid and BetP), so that the compiler vectorises across cells.
  */
 #pragma once
 

@@ -56,8 +56,8 @@ struct PlaneLayout<FrameMG>
 /**
  * @brief A grid of mass functions on @p Frame, cells row-major. Each stored subset a has a slot (slot(a)); the slot
  *        after the last holds the counter ζ (used by the MapGrid, zero elsewhere). A subset that is not stored has
- *        mass 0 in every cell. The value of slot s of cell i is planes()[offset(i) + s · stride()]: planar layouts
- *        (offset(i) = i, stride() = the plane length) also give each slot as a plane (plane(), counter());
+ *        mass 0 in every cell. The value of slot s of cell i is planes()[blockOffset(i) + s · stride()]: planar
+ *        layouts (blockOffset(i) = i, stride() = the plane length) also give each slot as a plane (plane(), counter());
  *        interleaved ones (PlaneLayout::kBlockCells) are read and written through at(), zeta() and value().
  */
 template <class Frame>
@@ -138,8 +138,6 @@ public:
   /// Distance in floats between two consecutive slots of one cell: the plane length of a planar grid,
   /// kBlockCells of an interleaved one.
   std::size_t stride() const { return stride_; }
-  /// Where cell @p i starts: its slot s is stride() · s further.
-  std::size_t offset(std::size_t i) const { return blockOffset(i); }
 
   /// The plane of subset @p a (planar layouts only). @throws std::out_of_range when @p a is not stored.
   float* plane(Subset a)
@@ -167,8 +165,8 @@ public:
     return data_.data() + stride_ * kNumPlanes;
   }
   /// Slot @p s (kNumPlanes: ζ) of cell @p i.
-  float& value(int s, std::size_t i) { return data_[offset(i) + stride_ * static_cast<std::size_t>(s)]; }
-  float value(int s, std::size_t i) const { return data_[offset(i) + stride_ * static_cast<std::size_t>(s)]; }
+  float& value(int s, std::size_t i) { return data_[blockOffset(i) + stride_ * static_cast<std::size_t>(s)]; }
+  float value(int s, std::size_t i) const { return data_[blockOffset(i) + stride_ * static_cast<std::size_t>(s)]; }
   /// m(@p a) of cell @p i. @throws std::out_of_range when @p a is not stored.
   float& at(Subset a, std::size_t i) { return value(static_cast<int>(checkedSlot(a)), i); }
   float at(Subset a, std::size_t i) const { return value(static_cast<int>(checkedSlot(a)), i); }
