@@ -34,33 +34,27 @@ void BM_MapGridUpdate(benchmark::State& state)
   }
   PriorWindow prior(GridGeometry::centred(2.0 * n * res, 2.0 * n * res, res));
   for (std::size_t i = 0; i < prior.building.size(); ++i) (i % 3 == 0 ? prior.road : prior.other)[i] = 0.9f;
-  std::vector<std::int8_t> decision;
   double t = 0.0;
   Pose2 pose;
   StageTimes sum;
-  double decide_s = 0.0;
   for (auto _ : state)
   {
     pose.x += 1.0;  // 10 m/s at 10 Hz: the window shifts every scan
     pose.yaw += 0.01;
     StageTimes st;
     grid.update(scan, pose, t += 0.1, &prior, &st);
-    const auto d0 = std::chrono::steady_clock::now();
-    decide(grid.masses(), grid.pignistic(), params.decision_threshold, decision, &grid.parallel());
-    decide_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
     sum.shift += st.shift;
     sum.project_scan += st.project_scan;
     sum.prior_window += st.prior_window;
     sum.fusion += st.fusion;
     benchmark::ClobberMemory();
   }
-  // Mean milliseconds per scan of each stage (the fusion stage includes BetP and motion spreading).
+  // Mean milliseconds per scan of each stage (the fusion stage includes BetP, the decisions and motion spreading).
   const double k = 1e3 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["shift_ms"] = sum.shift * k;
   state.counters["project_ms"] = sum.project_scan * k;
   state.counters["prior_ms"] = sum.prior_window * k;
   state.counters["fusion_ms"] = sum.fusion * k;
-  state.counters["decide_ms"] = decide_s * k;
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n) * n);
 }
 

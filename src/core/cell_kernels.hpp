@@ -4,11 +4,14 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 
+#include "map_aided_fusion/core/cell_class.hpp"
 #include "map_aided_fusion/core/counter.hpp"
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/frame.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
+#include "fusion_kernel.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__)
 #define MAF_UNROLL _Pragma("GCC unroll 64")
@@ -22,9 +25,11 @@
 #define MAF_INLINE inline
 #define MAF_LAMBDA_INLINE
 #endif
-// Whole-grid loops get an AVX2+FMA clone chosen at run time where the CPU has it.
+// Whole-grid loops get clones chosen at run time by the CPU: AVX2+FMA (x86-64-v3) and AVX-512 (x86-64-v4, whose 32
+// vector registers hold twice the live masses of the 16 of AVX2; the vectors stay eight floats wide). The two
+// clones give the same bits: both contract the same products into FMAs.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(MAF_NO_TARGET_CLONES)
-#define MAF_TARGET_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define MAF_TARGET_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define MAF_TARGET_CLONES
 #endif
@@ -73,6 +78,16 @@ MAF_INLINE Vec8 load<Vec8>(const float* p)
 }
 MAF_INLINE void store(float* p, float v) { *p = v; }
 MAF_INLINE void store(float* p, Vec8 v) { __builtin_memcpy(p, &v, sizeof v); }
+
+/// Stores class codes held as floats (small integers) as bytes.
+MAF_INLINE void storeClass(std::int8_t* p, float v) { *p = static_cast<std::int8_t>(v); }
+MAF_INLINE void storeClass(std::int8_t* p, Vec8 v)
+{
+  using Vec8i = int __attribute__((vector_size(32)));
+  using Vec8b = signed char __attribute__((vector_size(8)));
+  const Vec8b b = __builtin_convertvector(__builtin_convertvector(v, Vec8i), Vec8b);
+  __builtin_memcpy(p, &b, sizeof b);
+}
 
 /// Floats between two slots of one MapGrid cell (the cells of a block are consecutive).
 constexpr std::size_t kSlotStride = MapMassGrid::kBlockCells;
@@ -420,6 +435,39 @@ MAF_INLINE void renormalise(T (&m)[kSubsets])
   const T scale = select(omega < zero, one / select(others > zero, others, one), one);
   MAF_UNROLL
   for (int a = 0; a < kSubsets - 1; ++a) m[a] *= scale;
+}
+
+/// m(Ω) from which a cell counts as vacuous (never observed): no decision.
+constexpr float kVacuousTolerance = 1e-3f;
+
+/**
+ * The decision of a cell (a CellClass code, as T) from its BetP @p p and m(Ω) (see decide() in map_grid.hpp): the
+ * class of largest BetP (the first on ties) when it reaches the threshold and the cell is not vacuous, else kUnknown;
+ * with the motion margin, S or V decisions within the margin of each other, and observed cells no class decides but
+ * whose occupied BetP reaches the threshold, are kOccupied.
+ */
+template <typename T>
+MAF_INLINE T decideCell(const T (&p)[FrameMG::kSize], T omega, const DecisionRule& rule)
+{
+  T best_p = p[0];
+  T best = T{};
+  MAF_UNROLL
+  for (int e = 1; e < FrameMG::kSize; ++e)
+  {
+    const auto better = p[e] > best_p;
+    best_p = select(better, p[e], best_p);
+    best = select(better, splat<T>(static_cast<float>(e)), best);
+  }
+  const auto observed = omega < 1.0f - kVacuousTolerance;
+  const auto known = observed & (best_p >= rule.threshold);
+  const T d = select(known, best, splat<T>(static_cast<float>(CellClass::kUnknown)));
+  if (!rule.motion_margin) return d;
+  constexpr int kS = FrameMG::kSize - 2, kV = FrameMG::kSize - 1;
+  const auto motion = (best == static_cast<float>(CellClass::kStopped)) | (best == static_cast<float>(CellClass::kMoving));
+  // |BetP(S) − BetP(V)| < margin, both differences being exact negatives of each other.
+  const auto tie = known & motion & (p[kS] - p[kV] < rule.margin) & (p[kV] - p[kS] < rule.margin);
+  const auto unclassified = (known == 0) & observed & (1.0f - p[0] >= rule.threshold);
+  return select(tie | unclassified, splat<T>(static_cast<float>(CellClass::kOccupied)), d);
 }
 
 /// Mass on the non-empty subsets of {C, N, S, V}.

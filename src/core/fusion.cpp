@@ -1,6 +1,8 @@
 #include "map_aided_fusion/core/fusion.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -63,13 +65,32 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   return r;
 }
 
+namespace {
+
+/// True when some of the @p n floats from @p p has a bit set (is not +0): an OR of the bit patterns, which
+/// vectorises, unlike a search that stops at the first.
+bool anyBitSet(const float* p, std::size_t n)
+{
+  std::uint32_t bits = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    std::uint32_t b;
+    std::memcpy(&b, p + i, sizeof b);
+    bits |= b;
+  }
+  return bits != 0;
+}
+
+}  // namespace
+
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
-                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel)
+                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
 {
   params.validate();
   if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
   if (prior && prior->geometry != map.geometry())
     throw std::invalid_argument("fusionStep: prior window and map grid differ");
+  if (decisions && decisions->out && !betp) throw std::invalid_argument("fusionStep: decisions need the BetP planes");
   const ContextualDiscountWeights<float> w(params.discount);
   kernels::StepInputs in;
   in.base = map.planes();
@@ -99,14 +120,26 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
     if (betp) betp->p[e].resize(in.cells);
     in.betp[e] = betp ? betp->p[e].data() : nullptr;
   }
+  in.decision = nullptr;
+  if (decisions && decisions->out)
+  {
+    decisions->out->resize(in.cells);
+    in.decision = decisions->out->data();
+    in.decision_rule.threshold = static_cast<float>(decisions->threshold);
+    in.decision_rule.motion_margin = decisions->motion_margin > 0.0;
+    in.decision_rule.margin = static_cast<float>(decisions->motion_margin);
+  }
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
-  const bool has_prior = prior != nullptr, wall = prior && prior->hasWall();
+  const bool has_prior = prior != nullptr;
+  const float* const wall_plane = prior && prior->wall.size() == in.cells ? prior->wall.data() : nullptr;
   // Fixed chunks (independent of the thread count), their statistics summed in chunk order: bit-identical results.
   static_assert(kFusionChunkCells % MapMassGrid::kBlockCells == 0, "chunks start on a block of the MapGrid");
   const std::size_t chunks = chunkCount(in.cells, kFusionChunkCells);
   std::vector<FusionStepStats> partial(chunks);
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
+    // The wall terms only in chunks with mass on W: on a zero wall mass both loops give the same bits.
+    const bool wall = wall_plane && anyBitSet(wall_plane + begin, end - begin);
     kernels::fusionChunk(in.offset(begin, end - begin), w, has_prior, wall, paper, partial[c]);
   };
   orSerial(parallel).forChunks(chunks, chunk);

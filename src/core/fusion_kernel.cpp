@@ -74,6 +74,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       pignistic(m, p);
       MAF_UNROLL
       for (int e = 0; e < FrameMG::kSize; ++e) store(in.betp[e] + i, p[e]);
+      if (in.decision) storeClass(in.decision + i, decideCell(p, m[FrameMG::kOmega], in.decision_rule));
     }
     sums.add(c);
   });

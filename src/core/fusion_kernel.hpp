@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/fusion.hpp"
@@ -13,6 +14,14 @@
 namespace map_aided_fusion {
 namespace core {
 namespace kernels {
+
+/// What a cell's decision needs besides BetP and m(Ω): the threshold and the step "motion margin" (MapGridParams).
+struct DecisionRule
+{
+  float threshold = 0.0f;
+  bool motion_margin = false;  ///< MapGridParams::motion_margin > 0
+  float margin = 0.0f;
+};
 
 /// Everything the fused loop reads, hoisted out of it.
 struct StepInputs
@@ -34,6 +43,8 @@ struct StepInputs
   bool use_counter;
   bool moving_expiry;
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
+  std::int8_t* decision;        ///< decisions to fill (with BetP only), or nullptr
+  DecisionRule decision_rule;
 
   /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved. @p begin must start a block
   /// of the MapGrid (a multiple of MapMassGrid::kBlockCells).
@@ -52,12 +63,14 @@ struct StepInputs
     move(o.pt);
     move(o.pw);
     for (auto*& b : o.betp) move(b);
+    move(o.decision);
     o.cells = count;
     return o;
   }
 };
 
-/// The fused step on the cells of @p in (one chunk): masses, ζ and BetP in place, conflicts summed into @p out.
+/// The fused step on the cells of @p in (one chunk): masses, ζ, BetP and decisions in place, conflicts summed into
+/// @p out.
 void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w, bool has_prior, bool wall, bool paper,
                  FusionStepStats& out);
 

@@ -34,8 +34,6 @@ constexpr std::size_t kShiftRows = 16;         // window rows per chunk of a shi
 constexpr double kMinBudgetMb = 1.0;
 constexpr double kMaxBudgetMb = 1048576.0;
 constexpr double kBytesPerMb = 1048576.0;
-/// m(Ω) at or above 1 − this is a vacuous cell.
-constexpr float kVacuousTolerance = 1e-3f;
 /// Largest obstacle_clearance, m.
 constexpr double kMaxObstacleClearance = 5.0;
 
@@ -497,30 +495,35 @@ float* omegaBuffer()
   return buffer.data();
 }
 
-/// decide() on the cells [i0, i1), whose m(Ω) are @p omega[0, i1 − i0); the output (bytes may alias anything) is
-/// written through a restricted pointer so that the loop vectorises.
-void decideCells(const float* __restrict omega, const float* const* p, float t, std::int8_t* __restrict d,
-                 std::size_t i0, std::size_t i1)
+/// decide() on the cells [i0, i1), whose m(Ω) are @p omega[0, i1 − i0).
+void decideCells(const float* __restrict omega, const float* const* p, const kernels::DecisionRule& rule,
+                 std::int8_t* __restrict d, std::size_t i0, std::size_t i1)
 {
-  const float* __restrict p0 = p[0];
-  const float* __restrict p1 = p[1];
-  const float* __restrict p2 = p[2];
-  const float* __restrict p3 = p[3];
-  const float* __restrict p4 = p[4];
   static_assert(FrameMG::kSize == 5, "one pointer per element of Ω");
-  for (std::size_t i = i0; i < i1; ++i)
+  kernels::forEachCell(i1 - i0, [&](auto lane, std::size_t k) {
+    using T = decltype(lane);
+    const std::size_t i = i0 + k;
+    const T q[FrameMG::kSize] = { kernels::load<T>(p[0] + i), kernels::load<T>(p[1] + i), kernels::load<T>(p[2] + i),
+                                  kernels::load<T>(p[3] + i), kernels::load<T>(p[4] + i) };
+    kernels::storeClass(d + i, kernels::decideCell(q, kernels::load<T>(omega + k), rule));
+  });
+}
+
+kernels::DecisionRule decisionRule(double threshold, double motion_margin)
+{
+  return kernels::DecisionRule{ static_cast<float>(threshold), motion_margin > 0.0, static_cast<float>(motion_margin) };
+}
+
+/// decide() again on the listed cells only (those motion spreading changed).
+void redecide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
+              const std::vector<std::size_t>& cells, std::vector<std::int8_t>& out)
+{
+  const kernels::DecisionRule rule = decisionRule(params.decision_threshold, params.motion_margin);
+  const int omega = MapMassGrid::slot(FrameMG::kOmega);
+  for (const std::size_t i : cells)
   {
-    const float q[FrameMG::kSize] = { p0[i], p1[i], p2[i], p3[i], p4[i] };
-    float best_p = q[0];
-    std::int8_t best = 0;
-    for (int e = 1; e < FrameMG::kSize; ++e)
-    {
-      const bool better = q[e] > best_p;
-      best_p = better ? q[e] : best_p;
-      best = better ? static_cast<std::int8_t>(e) : best;
-    }
-    const bool known = omega[i - i0] < 1.0f - kVacuousTolerance && best_p >= t;
-    d[i] = known ? best : static_cast<std::int8_t>(CellClass::kUnknown);
+    const float q[FrameMG::kSize] = { betp[0][i], betp[1][i], betp[2][i], betp[3][i], betp[4][i] };
+    kernels::storeClass(out.data() + i, kernels::decideCell(q, grid.value(omega, i), rule));
   }
 }
 
@@ -541,32 +544,26 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
   const std::size_t n = grid.numCells();
   out.resize(n);
   const float* p[FrameMG::kSize] = { betp[0].data(), betp[1].data(), betp[2].data(), betp[3].data(), betp[4].data() };
-  const float t = static_cast<float>(params.decision_threshold);
-  const float margin = static_cast<float>(params.motion_margin);
-  const float* ps = betp[FrameMG::kSize - 2].data();
-  const float* pv = betp[FrameMG::kSize - 1].data();
-  const float* pf = betp[0].data();
-  const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
-  const auto unknown = static_cast<std::int8_t>(CellClass::kUnknown);
+  const kernels::DecisionRule rule = decisionRule(params.decision_threshold, params.motion_margin);
   std::int8_t* const d = out.data();
-  // One copy of each chunk's m(Ω) out of the blocks serves both passes.
   orSerial(parallel).forRange(n, kCellChunk, [&](std::size_t i0, std::size_t i1) {
     float* const omega = omegaBuffer();
     gatherOmega(grid, i0, i1, omega);
-    decideCells(omega, p, t, d, i0, i1);
-    if (params.motion_margin <= 0.0) return;
-    for (std::size_t i = i0; i < i1; ++i)
-    {
-      const bool tie = (d[i] == stopped || d[i] == moving) && std::abs(ps[i] - pv[i]) < margin;
-      const bool unclassified = d[i] == unknown && omega[i - i0] < 1.0f - kVacuousTolerance && 1.0f - pf[i] >= t;
-      if (tie || unclassified) d[i] = static_cast<std::int8_t>(CellClass::kOccupied);
-    }
+    decideCells(omega, p, rule, d, i0, i1);
   });
 }
 
-std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
-                         int max_cells, double threshold, double margin, const Parallel* parallel)
+namespace {
+
+/// spreadMotion(), also giving the cells it changed (the calling thread's buffer, valid until its next call).
+std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
+                              int max_cells, double threshold, double margin, const Parallel* parallel,
+                              const std::vector<std::size_t>*& changed)
 {
+  thread_local std::vector<std::size_t> calling_thread_cells;
+  std::vector<std::size_t>& cells = calling_thread_cells;
+  cells.clear();
+  changed = &cells;
   if (share <= 0.0) return 0;
   const GridGeometry& g = grid.geometry();
   const std::size_t n = g.numCells();
@@ -582,12 +579,11 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
   // lambdas capture: a thread_local named inside a lambda would be the worker's own.
   thread_local std::vector<std::vector<std::size_t>> calling_thread_seeds;
   thread_local std::vector<std::uint8_t> calling_thread_seen;
-  thread_local std::vector<std::size_t> calling_thread_stack, calling_thread_region, calling_thread_cells;
+  thread_local std::vector<std::size_t> calling_thread_stack, calling_thread_region;
   std::vector<std::vector<std::size_t>>& seeds = calling_thread_seeds;
   std::vector<std::uint8_t>& seen = calling_thread_seen;
   std::vector<std::size_t>& stack = calling_thread_stack;
   std::vector<std::size_t>& region = calling_thread_region;
-  std::vector<std::size_t>& cells = calling_thread_cells;
   const std::size_t chunks = chunkCount(n, kCellChunk);
   if (seeds.size() < chunks) seeds.resize(chunks);
   orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
@@ -596,7 +592,6 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
       if (so[i] > 0.0f && is_moving(i)) seeds[c].push_back(i);
   });
   seen.assign(n, 0);
-  cells.clear();
   std::size_t spread = 0;
   for (std::size_t c = 0; c < chunks; ++c)
     for (const std::size_t start : seeds[c])
@@ -641,6 +636,15 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
     }
   });
   return spread;
+}
+
+}  // namespace
+
+std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
+                         int max_cells, double threshold, double margin, const Parallel* parallel)
+{
+  const std::vector<std::size_t>* changed = nullptr;
+  return spreadMotionCells(grid, betp, scan, share, max_cells, threshold, margin, parallel, changed);
 }
 
 std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<std::int8_t>& decision,
@@ -720,6 +724,7 @@ void MapGrid::setParams(const MapGridParams& params)
     pignisticGrid(grid_, betp_);
     scans_ = 0;
   }
+  decide(grid_, betp_, params_, decision_, parallel_.get());
 }
 
 void MapGrid::reset()
@@ -727,6 +732,7 @@ void MapGrid::reset()
   grid_.fillVacuous();
   std::fill(map_doubt_.begin(), map_doubt_.end(), 0.0f);
   pignisticGrid(grid_, betp_);
+  decide(grid_, betp_, params_, decision_, parallel_.get());
   scans_ = 0;
   last_stamp_ = 0.0;
 }
@@ -927,9 +933,15 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   FusionParams fp = params_.fusion;
   if (params_.rates_per_second && scans_ > 0) fp.discount = fp.discount.compounded(std::max(0.0, stamp - last_stamp_));
   FusionStepStats stats;
-  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_, parallel_.get());
-  spreadMotion(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells, params_.decision_threshold,
-               params_.motion_margin, parallel_.get());
+  StepDecisions decisions;
+  decisions.out = &decision_;
+  decisions.threshold = params_.decision_threshold;
+  decisions.motion_margin = params_.motion_margin;
+  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_, parallel_.get(), &decisions);
+  const std::vector<std::size_t>* spread = nullptr;
+  spreadMotionCells(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells,
+                    params_.decision_threshold, params_.motion_margin, parallel_.get(), spread);
+  redecide(grid_, betp_, params_, *spread, decision_);
   t.fusion = secondsSince(t0);
 
   last_stamp_ = stamp;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace map_aided_fusion {
 
@@ -12,6 +14,8 @@ namespace {
 
 constexpr float kOccupancyScale = 100.0f;
 constexpr std::int8_t kUnknownOccupancy = -1;
+/// A float's bits without its sign: zero for +0 and −0 only.
+constexpr std::uint32_t kMagnitudeBits = 0x7fffffffu;
 
 std::int8_t toOccupancyValue(float p)
 {
@@ -85,21 +89,69 @@ core::GridGeometry GridConversions::fromMapMetaData(const nav_msgs::MapMetaData&
 
 namespace {
 
-/// Slot @p s of every cell of @p grid, appended to @p out (for either layout of MassGrid).
+/// Slot @p s of every cell of @p grid, appended to @p out (for either layout of MassGrid; a planar slot is one
+/// contiguous copy, without zero-filling first).
 template <class Frame>
 void appendSlot(const core::MassGrid<Frame>& grid, int s, std::vector<float>& out)
 {
-  const std::size_t n = grid.numCells(), first = out.size();
-  out.resize(first + n);
-  float* const dst = out.data() + first;
-  for (std::size_t i = 0; i < n; ++i) dst[i] = grid.value(s, i);
+  const std::size_t n = grid.numCells();
+  if constexpr (!core::MassGrid<Frame>::kInterleaved)
+  {
+    const float* const src = grid.planes() + grid.stride() * static_cast<std::size_t>(s);
+    out.insert(out.end(), src, src + n);
+  }
+  else
+  {
+    const std::size_t first = out.size();
+    out.resize(first + n);
+    float* const dst = out.data() + first;
+    for (std::size_t i = 0; i < n; ++i) dst[i] = grid.value(s, i);
+  }
 }
 
 /// Slot @p s of every cell of @p grid from @p src (nullptr: zeros).
 template <class Frame>
 void writeSlot(core::MassGrid<Frame>& grid, int s, const float* src)
 {
-  for (std::size_t i = 0, n = grid.numCells(); i < n; ++i) grid.value(s, i) = src ? src[i] : 0.0f;
+  const std::size_t n = grid.numCells();
+  if constexpr (!core::MassGrid<Frame>::kInterleaved)
+  {
+    float* const dst = grid.planes() + grid.stride() * static_cast<std::size_t>(s);
+    if (src)
+      std::copy(src, src + n, dst);
+    else
+      std::fill(dst, dst + n, 0.0f);
+  }
+  else
+  {
+    for (std::size_t i = 0; i < n; ++i) grid.value(s, i) = src ? src[i] : 0.0f;
+  }
+}
+
+/// True when slot @p s of some cell of @p grid is not zero (a NaN counts): an OR over the bit patterns without the
+/// sign for planar slots, which vectorises.
+template <class Frame>
+bool anyNonZero(const core::MassGrid<Frame>& grid, int s)
+{
+  const std::size_t n = grid.numCells();
+  if constexpr (!core::MassGrid<Frame>::kInterleaved)
+  {
+    const float* const p = grid.planes() + grid.stride() * static_cast<std::size_t>(s);
+    std::uint32_t bits = 0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      std::uint32_t b;
+      std::memcpy(&b, p + i, sizeof b);
+      bits |= b & kMagnitudeBits;
+    }
+    return bits != 0;
+  }
+  else
+  {
+    for (std::size_t i = 0; i < n; ++i)
+      if (grid.value(s, i) != 0.0f) return true;
+    return false;
+  }
 }
 
 }  // namespace
@@ -118,9 +170,7 @@ void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msg
   {
     if (!grid.stored(static_cast<Subset>(a))) continue;  // mass 0 in every cell
     const int s = grid.slot(static_cast<Subset>(a));
-    bool any = planes == PlaneSelection::kAll;
-    for (std::size_t i = 0; i < n && !any; ++i) any = grid.value(s, i) != 0.0f;
-    if (any) msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
+    if (planes == PlaneSelection::kAll || anyNonZero(grid, s)) msg.focal_sets.push_back(static_cast<std::uint8_t>(a));
   }
   msg.masses.clear();  // appended plane by plane: no zero fill first
   msg.masses.reserve(msg.focal_sets.size() * n);

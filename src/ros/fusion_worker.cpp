@@ -24,6 +24,8 @@ constexpr double kMaxObjectBoxHeight = 100.0;
 /// Wall period of the clock watch (backward /clock jumps, transforms ahead of the clock), s.
 constexpr double kClockCheckPeriod = 0.1;
 constexpr double kWarnThrottle = 1.0;
+/// |Σm − 1| a scan cell may have (float rounding of the ScanGrid and its message).
+constexpr float kMassSumTolerance = 1e-3f;
 constexpr const char* kBetpTopics[core::FrameMG::kSize] = { "betp/free", "betp/building", "betp/infrastructure",
                                                              "betp/stopped", "betp/moving" };
 
@@ -354,12 +356,19 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     GridConversions::fromMessage(*msg, scan);
     const float *e = scan.plane(core::FrameSG::kEmpty), *f = scan.plane(core::FrameSG::kF),
                 *o = scan.plane(core::FrameSG::kO), *w = scan.plane(core::FrameSG::kOmega);
-    for (std::size_t i = 0; i < scan.numCells(); ++i)
-    {
+    const auto invalid = [&](std::size_t i) {
       const float s = e[i] + f[i] + o[i] + w[i];
-      if (!(std::abs(s - 1.0f) < 1e-3f) || !(e[i] >= 0.0f) || !(f[i] >= 0.0f) || !(o[i] >= 0.0f) || !(w[i] >= 0.0f))
-        throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " + std::to_string(s) + ")");
-    }
+      return !(std::abs(s - 1.0f) < kMassSumTolerance) || !(e[i] >= 0.0f) || !(f[i] >= 0.0f) || !(o[i] >= 0.0f) ||
+             !(w[i] >= 0.0f);
+    };
+    // One pass that vectorises tells whether a cell is bad; only then is the first one looked for, to name it.
+    bool any_invalid = false;
+    for (std::size_t i = 0; i < scan.numCells(); ++i) any_invalid |= invalid(i);
+    if (any_invalid)
+      for (std::size_t i = 0; i < scan.numCells(); ++i)
+        if (invalid(i))
+          throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " +
+                                std::to_string(e[i] + f[i] + o[i] + w[i]) + ")");
     if (msg->obstacle_points.size() % 2 != 0)
       throw ConversionError("obstacle_points holds an odd number of coordinates");
     for (const float v : msg->obstacle_points)
@@ -499,8 +508,7 @@ void FusionWorker::publish(const std_msgs::Header& header)
     GridConversions::pignisticToOccupancy(grid, betp, e, header, *occ);
     betp_pub_[e].publish(occ);
   }
-  std::vector<std::int8_t> decision;
-  core::decide(grid, betp, grid_.params(), decision, &grid_.parallel());
+  const std::vector<std::int8_t>& decision = grid_.decisions();
   const auto publishLayer = [&](ros::Publisher& pub, const std::vector<std::int8_t>& data) {
     auto occ = boost::make_shared<nav_msgs::OccupancyGrid>();
     occ->header = header;

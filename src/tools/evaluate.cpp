@@ -629,7 +629,7 @@ int main(int argc, char** argv)
         const core::PriorWindow* pw = v->use_prior ? v->softener.softened(sigma) : nullptr;
         v->grid.update(v->scan, pose, t, pw, nullptr, &obstacles);
         v->decision.geometry = v->grid.geometry();
-        core::decide(v->grid.masses(), v->grid.pignistic(), v->grid.params(), v->decision.cells, &v->grid.parallel());
+        v->decision.cells = v->grid.decisions();
         if (point_mode)
         {
           if (labelled)

@@ -106,6 +106,8 @@ struct Run
     const ObstaclePoints obstacles = builder.obstaclePoints();
     grid.update(scan, pose, kScanPeriod * ++scans, prior, nullptr, &obstacles);
     decide(grid.masses(), grid.pignistic(), grid.params(), decision);
+    // The decisions the update wrote in its passes are the ones decide() gives on its result.
+    ASSERT_EQ(grid.decisions(), decision) << "scan " << scans;
   }
 
   int count(CellClass c) const

@@ -134,6 +134,7 @@ DriveResult drive(int threads)
     r.betp.insert(r.betp.end(), grid.pignistic()[e].begin(), grid.pignistic()[e].end());
   r.doubt.assign(grid.mapDoubt().begin(), grid.mapDoubt().end());
   decide(m, grid.pignistic(), grid.params(), r.decision, &grid.parallel());
+  EXPECT_EQ(grid.decisions(), r.decision) << "the update's decisions are decide() on its result";
   return r;
 }
 

@@ -1,7 +1,9 @@
 // rostest of the pipeline at high resolution (test/high_resolution.test): ~130k-point clouds at 10 Hz through the
 // three nodelets with an 800 x 800 window at 0.2 m, the vehicle driving east along Main Street at `speed`. Checks that
 // the decisions have the configured size and that clouds are fused; reports the cloud stamp -> decision latency
-// (median, p90, max) and the clouds that produced no decision (speed is measured here, not asserted).
+// (median, p90, max) and the clouds that produced no decision (speed is measured here, not asserted), and from the
+// nodelets' diagnostics (sampled while the clouds flow) where the time goes: the ScanGrid build, the MapGrid update
+// and the fusion callback with its outputs.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,8 +11,10 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <string>
 #include <vector>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
@@ -24,6 +28,48 @@ namespace {
 
 constexpr double kScanPeriod = 0.1;
 constexpr double kStartX = -120.0, kLaneY = -1.5;
+
+double median(std::vector<double> v)
+{
+  if (v.empty()) return -1.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// The diagnostics' stage times, one sample per diagnostics message while clouds flow.
+struct StageSamples
+{
+  std::vector<double> scan_grid_ms, update_ms, callback_ms;
+
+  void add(const diagnostic_msgs::DiagnosticArray& m)
+  {
+    for (const auto& s : m.status)
+    {
+      auto endsWith = [&](const std::string& tail) {
+        return s.name.size() >= tail.size() && s.name.compare(s.name.size() - tail.size(), tail.size(), tail) == 0;
+      };
+      std::map<std::string, double> v;
+      for (const auto& kv : s.values)
+      {
+        try
+        {
+          v[kv.key] = std::stod(kv.value);
+        }
+        catch (const std::exception&)
+        {
+        }
+      }
+      if (endsWith(": ScanGrid") && v.count("processing time mean (ms)") && v["processing time mean (ms)"] > 0.0)
+        scan_grid_ms.push_back(v["processing time mean (ms)"]);
+      if (endsWith(": fusion") && v.count("time total with outputs [ms]") && v["time total with outputs [ms]"] > 0.0)
+      {
+        callback_ms.push_back(v["time total with outputs [ms]"]);
+        update_ms.push_back(v["time shift [ms]"] + v["time project scan [ms]"] + v["time prior window [ms]"] +
+                            v["time fusion [ms]"]);
+      }
+    }
+  }
+};
 
 TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
 {
@@ -41,6 +87,13 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
     width = m->info.width;
     height = m->info.height;
   });
+  StageSamples stages;
+  bool sampling = false;
+  ros::Subscriber diagnostics = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 50, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (sampling) stages.add(*m);
+      });
   ros::Publisher points = nh.advertise<sensor_msgs::PointCloud2>("points", 4);
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::StaticTransformBroadcaster static_broadcaster;
@@ -61,6 +114,11 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   ros::WallTime next = ros::WallTime::now();
   for (int k = 0; k < clouds; ++k)
   {
+    if (k == clouds / 10)
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      sampling = true;  // past the first clouds (allocation, the first recentring)
+    }
     const ros::Time stamp = ros::Time::now();
     geometry_msgs::TransformStamped t;
     t.header.frame_id = "map";
@@ -79,6 +137,10 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
     const ros::WallDuration wait = next - ros::WallTime::now();
     if (wait > ros::WallDuration(0)) wait.sleep();
   }
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    sampling = false;
+  }
   ros::WallDuration(2.0).sleep();
   spinner.stop();
 
@@ -93,6 +155,12 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
             << (l.empty() ? 0.0 : l[l.size() / 2]) << ", p90 " << (l.empty() ? 0.0 : l[l.size() * 9 / 10]) << ", max "
             << (l.empty() ? 0.0 : l.back()) << "; clouds without a decision: " << dropped << " of " << sent.size()
             << "\n";
+  std::cout << "stage medians over " << stages.callback_ms.size() << " diagnostics samples (ms): ScanGrid build "
+            << median(stages.scan_grid_ms) << ", MapGrid update " << median(stages.update_ms)
+            << ", fusion callback with outputs " << median(stages.callback_ms) << "\n";
+  RecordProperty("scan_grid_ms", static_cast<int>(std::lround(median(stages.scan_grid_ms))));
+  RecordProperty("update_ms", static_cast<int>(std::lround(median(stages.update_ms))));
+  RecordProperty("fusion_callback_ms", static_cast<int>(std::lround(median(stages.callback_ms))));
   RecordProperty("points_per_cloud", static_cast<int>(per_cloud));
   RecordProperty("latency_median_ms", l.empty() ? -1 : static_cast<int>(std::lround(l[l.size() / 2])));
   RecordProperty("latency_p90_ms", l.empty() ? -1 : static_cast<int>(std::lround(l[l.size() * 9 / 10])));

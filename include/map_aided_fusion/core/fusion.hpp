@@ -10,7 +10,9 @@
  */
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "map_aided_fusion/core/counter.hpp"
 #include "map_aided_fusion/core/discounting.hpp"
@@ -90,6 +92,14 @@ struct FusionStepStats
   }
 };
 
+/// The decisions fusionStep() can write in the pass that computes BetP: the rule of decide() in map_grid.hpp.
+struct StepDecisions
+{
+  std::vector<std::int8_t>* out = nullptr;  ///< resized to the grid's cells; CellClass codes
+  double threshold = 0.4;                   ///< MapGridParams::decision_threshold
+  double motion_margin = 0.0;               ///< MapGridParams::motion_margin (0: the step is off)
+};
+
 /**
  * @brief One fusion step on a whole grid, in place, all stages fused in one pass over the cells.
  *
@@ -98,11 +108,14 @@ struct FusionStepStats
  * @param prior  the prior window of the same geometry, or nullptr for a vacuous prior.
  * @param betp   when not null, receives BetP of m'_MG,t (computed in the same pass).
  * @param parallel  when not null, the threads the cells are shared among (chunks of kFusionChunkCells); the masses,
- *                  BetP and statistics are bit-identical for any number of threads.
- * @throws std::invalid_argument when the geometries differ.
+ *                  BetP, decisions and statistics are bit-identical for any number of threads.
+ * @param decisions when not null (with @p betp), receives the decision of each cell, the same as decide() on the new
+ *                  masses and BetP would give.
+ * @throws std::invalid_argument when the geometries differ, or decisions are asked for without BetP.
  */
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
-                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr, const Parallel* parallel = nullptr);
+                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr, const Parallel* parallel = nullptr,
+                const StepDecisions* decisions = nullptr);
 
 /// Cells per chunk of a parallel fusion step (a multiple of the 8-cell vectors and of the prefetch blocks).
 constexpr std::size_t kFusionChunkCells = 16384;

@@ -307,6 +307,9 @@ public:
   const GridGeometry& geometry() const { return grid_.geometry(); }
   /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
   const PignisticPlanes& pignistic() const { return betp_; }
+  /// The decision of every cell after the last update (decide() with these parameters, written in the fusion pass
+  /// and again where motion spreading changed a cell); the same as decide(masses(), pignistic(), params()).
+  const std::vector<std::int8_t>& decisions() const { return decision_; }
   /// Number of scans fused since the last reset.
   std::size_t scans() const { return scans_; }
   /// The map doubt η of every window cell (step map_conflict; zeros when it is off).
@@ -323,6 +326,7 @@ private:
   PriorWindow prior_window_;
   AlignedVector<float> map_doubt_;
   PignisticPlanes betp_;
+  std::vector<std::int8_t> decision_;
   std::shared_ptr<const Parallel> parallel_;
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;
