@@ -90,7 +90,6 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
   if (prior && prior->geometry != map.geometry())
     throw std::invalid_argument("fusionStep: prior window and map grid differ");
-  if (decisions && decisions->out && !betp) throw std::invalid_argument("fusionStep: decisions need the BetP planes");
   const ContextualDiscountWeights<float> w(params.discount);
   kernels::StepInputs in;
   in.base = map.planes();
@@ -121,13 +120,19 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
     in.betp[e] = betp ? betp->p[e].data() : nullptr;
   }
   in.decision = nullptr;
+  in.seeds = nullptr;
+  in.first = 0;
+  if (decisions && (decisions->out || decisions->motion_seeds))
+  {
+    if (!betp) throw std::invalid_argument("fusionStep: decisions need the BetP planes");
+    in.decision_rule.threshold = static_cast<float>(decisions->threshold);
+    in.decision_rule.motion_margin = decisions->motion_margin > 0.0;
+    in.decision_rule.margin = static_cast<float>(decisions->motion_margin);
+  }
   if (decisions && decisions->out)
   {
     decisions->out->resize(in.cells);
     in.decision = decisions->out->data();
-    in.decision_rule.threshold = static_cast<float>(decisions->threshold);
-    in.decision_rule.motion_margin = decisions->motion_margin > 0.0;
-    in.decision_rule.margin = static_cast<float>(decisions->motion_margin);
   }
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
   const bool has_prior = prior != nullptr;
@@ -136,11 +141,19 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   static_assert(kFusionChunkCells % MapMassGrid::kBlockCells == 0, "chunks start on a block of the MapGrid");
   const std::size_t chunks = chunkCount(in.cells, kFusionChunkCells);
   std::vector<FusionStepStats> partial(chunks);
+  std::vector<std::vector<std::size_t>>* const seeds = decisions ? decisions->motion_seeds : nullptr;
+  if (seeds && seeds->size() < chunks) seeds->resize(chunks);
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
     // The wall terms only in chunks with mass on W: on a zero wall mass both loops give the same bits.
     const bool wall = wall_plane && anyBitSet(wall_plane + begin, end - begin);
-    kernels::fusionChunk(in.offset(begin, end - begin), w, has_prior, wall, paper, partial[c]);
+    kernels::StepInputs chunk_in = in.offset(begin, end - begin);
+    if (seeds)
+    {
+      (*seeds)[c].clear();
+      chunk_in.seeds = &(*seeds)[c];
+    }
+    kernels::fusionChunk(chunk_in, w, has_prior, wall, paper, partial[c]);
   };
   orSerial(parallel).forChunks(chunks, chunk);
   FusionStepStats total;

@@ -35,6 +35,18 @@ struct ConflictSums
   }
 };
 
+/// Appends the cells @p first + lane whose lane of @p seed is set (rare: moving cells the scan sees occupied).
+MAF_INLINE void appendSeeds(int seed, std::size_t first, std::vector<std::size_t>& out)
+{
+  if (seed) out.push_back(first);
+}
+template <typename M>
+MAF_INLINE void appendSeeds(M seed, std::size_t first, std::vector<std::size_t>& out)
+{
+  for (std::size_t l = 0; l < kLanes; ++l)
+    if (seed[l]) out.push_back(first + l);
+}
+
 /// kPaper: the paper's method (⊛, contextual discounting, counter) compiled without the ablation branches,
 /// which costs about a fifth of the time; otherwise the options are read at run time.
 template <bool kHasPrior, bool kPaper, bool kWall>
@@ -75,6 +87,9 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       MAF_UNROLL
       for (int e = 0; e < FrameMG::kSize; ++e) store(in.betp[e] + i, p[e]);
       if (in.decision) storeClass(in.decision + i, decideCell(p, m[FrameMG::kOmega], in.decision_rule));
+      if (in.seeds) appendSeeds(isMovingSeed(load<T>(in.so + i), p[FrameMG::kSize - 1], p[FrameMG::kSize - 2],
+                                             in.decision_rule.threshold, in.decision_rule.margin),
+                                in.first + i, *in.seeds);
     }
     sums.add(c);
   });

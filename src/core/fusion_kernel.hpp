@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "map_aided_fusion/core/discounting.hpp"
 #include "map_aided_fusion/core/fusion.hpp"
@@ -45,6 +46,8 @@ struct StepInputs
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
   std::int8_t* decision;        ///< decisions to fill (with BetP only), or nullptr
   DecisionRule decision_rule;
+  std::vector<std::size_t>* seeds;  ///< motion spreading's seeds to append (with BetP only), or nullptr
+  std::size_t first;                ///< index of the first cell in the whole grid (what the seeds record)
 
   /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved. @p begin must start a block
   /// of the MapGrid (a multiple of MapMassGrid::kBlockCells).
@@ -64,6 +67,7 @@ struct StepInputs
     move(o.pw);
     for (auto*& b : o.betp) move(b);
     move(o.decision);
+    o.first += begin;
     o.cells = count;
     return o;
   }

@@ -555,9 +555,12 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
 
 namespace {
 
-/// spreadMotion(), also giving the cells it changed (the calling thread's buffer, valid until its next call).
+/// spreadMotion(), also giving the cells it changed (the calling thread's buffer, valid until its next call). With
+/// @p found_seeds (the fused step's, StepDecisions::motion_seeds, per chunk in index order) the seeds are not looked
+/// for again.
 std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
                               int max_cells, double threshold, double margin, const Parallel* parallel,
+                              const std::vector<std::vector<std::size_t>>* found_seeds,
                               const std::vector<std::size_t>*& changed)
 {
   thread_local std::vector<std::size_t> calling_thread_cells;
@@ -573,31 +576,43 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const Sc
   const float t = static_cast<float>(threshold);
   const float m = static_cast<float>(margin);
   auto is_moving = [&](std::size_t i) { return pv[i] >= t && pv[i] - ps[i] > m; };
+  static_assert(kCellChunk == kFusionChunkCells, "the step's seed lists are the chunks of this pass");
   // A region without a moving cell is left alone: only the occupied moving cells seed one. They are found by fixed
   // chunks in parallel and taken in index order, so the regions (disjoint) are the same for any thread count.
   // The calling thread's buffers, kept from scan to scan (no allocation per scan). References to them are what the
   // lambdas capture: a thread_local named inside a lambda would be the worker's own.
   thread_local std::vector<std::vector<std::size_t>> calling_thread_seeds;
   thread_local std::vector<std::uint8_t> calling_thread_seen;
-  thread_local std::vector<std::size_t> calling_thread_stack, calling_thread_region;
+  thread_local std::vector<std::size_t> calling_thread_stack, calling_thread_region, calling_thread_visited;
   std::vector<std::vector<std::size_t>>& seeds = calling_thread_seeds;
   std::vector<std::uint8_t>& seen = calling_thread_seen;
   std::vector<std::size_t>& stack = calling_thread_stack;
   std::vector<std::size_t>& region = calling_thread_region;
+  std::vector<std::size_t>& visited = calling_thread_visited;  // the cells of every region grown last time
   const std::size_t chunks = chunkCount(n, kCellChunk);
-  if (seeds.size() < chunks) seeds.resize(chunks);
-  orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
-    seeds[c].clear();
-    for (std::size_t i = c * kCellChunk, end = std::min(n, i + kCellChunk); i < end; ++i)
-      if (so[i] > 0.0f && is_moving(i)) seeds[c].push_back(i);
-  });
-  seen.assign(n, 0);
+  if (!found_seeds)
+  {
+    if (seeds.size() < chunks) seeds.resize(chunks);
+    orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
+      seeds[c].clear();
+      for (std::size_t i = c * kCellChunk, end = std::min(n, i + kCellChunk); i < end; ++i)
+        if (kernels::isMovingSeed(so[i], pv[i], ps[i], t, m)) seeds[c].push_back(i);
+    });
+  }
+  const std::vector<std::vector<std::size_t>>& starts = found_seeds ? *found_seeds : seeds;
+  // Only the cells marked last time are cleared (a window of cells otherwise).
+  if (seen.size() == n)
+    for (const std::size_t i : visited) seen[i] = 0;
+  else
+    seen.assign(n, 0);
+  visited.clear();
   std::size_t spread = 0;
-  for (std::size_t c = 0; c < chunks; ++c)
-    for (const std::size_t start : seeds[c])
+  for (std::size_t c = 0; c < chunks && c < starts.size(); ++c)
+    for (const std::size_t start : starts[c])
     {
       if (seen[start]) continue;
       growRegion(g, start, [so](std::size_t j) { return so[j] > 0.0f; }, seen, stack, region);
+      visited.insert(visited.end(), region.begin(), region.end());
       std::size_t moving = 0;
       for (const std::size_t i : region) moving += is_moving(i);
       if (static_cast<int>(region.size()) > max_cells ||
@@ -644,7 +659,7 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
                          int max_cells, double threshold, double margin, const Parallel* parallel)
 {
   const std::vector<std::size_t>* changed = nullptr;
-  return spreadMotionCells(grid, betp, scan, share, max_cells, threshold, margin, parallel, changed);
+  return spreadMotionCells(grid, betp, scan, share, max_cells, threshold, margin, parallel, nullptr, changed);
 }
 
 std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<std::int8_t>& decision,
@@ -937,10 +952,11 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   decisions.out = &decision_;
   decisions.threshold = params_.decision_threshold;
   decisions.motion_margin = params_.motion_margin;
+  if (params_.motion_share > 0.0) decisions.motion_seeds = &motion_seeds_;
   fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_, parallel_.get(), &decisions);
   const std::vector<std::size_t>* spread = nullptr;
   spreadMotionCells(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells,
-                    params_.decision_threshold, params_.motion_margin, parallel_.get(), spread);
+                    params_.decision_threshold, params_.motion_margin, parallel_.get(), &motion_seeds_, spread);
   redecide(grid_, betp_, params_, *spread, decision_);
   t.fusion = secondsSince(t0);
 

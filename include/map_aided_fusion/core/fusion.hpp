@@ -98,6 +98,9 @@ struct StepDecisions
   std::vector<std::int8_t>* out = nullptr;  ///< resized to the grid's cells; CellClass codes
   double threshold = 0.4;                   ///< MapGridParams::decision_threshold
   double motion_margin = 0.0;               ///< MapGridParams::motion_margin (0: the step is off)
+  /// When not null, also the cells that seed motion spreading (see spreadMotion() in map_grid.hpp, with this threshold
+  /// and margin): one list per chunk of kFusionChunkCells cells, in index order.
+  std::vector<std::vector<std::size_t>>* motion_seeds = nullptr;
 };
 
 /**

@@ -327,6 +327,7 @@ private:
   AlignedVector<float> map_doubt_;
   PignisticPlanes betp_;
   std::vector<std::int8_t> decision_;
+  std::vector<std::vector<std::size_t>> motion_seeds_;  // the fused step's seeds of motion spreading, per chunk
   std::shared_ptr<const Parallel> parallel_;
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;
