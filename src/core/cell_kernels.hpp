@@ -480,12 +480,19 @@ MAF_INLINE T decideCell(const T (&p)[FrameMG::kSize], T omega, const DecisionRul
   return select(tie | unclassified, splat<T>(static_cast<float>(CellClass::kOccupied)), d);
 }
 
-/// A cell that seeds motion spreading (see spreadMotion()): the scan sees it occupied (@p so > 0) and it is decided
-/// moving, BetP(V) @p pv ≥ @p threshold and above BetP(S) @p ps by more than @p margin.
+/// A cell motion spreading counts as moving: BetP(V) @p pv ≥ @p threshold and above BetP(S) @p ps by more than
+/// @p margin.
+template <typename T>
+MAF_INLINE auto isMoving(T pv, T ps, float threshold, float margin)
+{
+  return (pv >= threshold) & (pv - ps > margin);
+}
+
+/// A cell that seeds motion spreading (see spreadMotion()): moving, and the scan sees it occupied (@p so > 0).
 template <typename T>
 MAF_INLINE auto isMovingSeed(T so, T pv, T ps, float threshold, float margin)
 {
-  return (so > 0.0f) & (pv >= threshold) & (pv - ps > margin);
+  return (so > 0.0f) & isMoving(pv, ps, threshold, margin);
 }
 
 /// Mass on the non-empty subsets of {C, N, S, V}.

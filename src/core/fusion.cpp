@@ -1,8 +1,6 @@
 #include "map_aided_fusion/core/fusion.hpp"
 
 #include <algorithm>
-#include <cstdint>
-#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -64,24 +62,6 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   }
   return r;
 }
-
-namespace {
-
-/// True when some of the @p n floats from @p p has a bit set (is not +0): an OR of the bit patterns, which
-/// vectorises, unlike a search that stops at the first.
-bool anyBitSet(const float* p, std::size_t n)
-{
-  std::uint32_t bits = 0;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    std::uint32_t b;
-    std::memcpy(&b, p + i, sizeof b);
-    bits |= b;
-  }
-  return bits != 0;
-}
-
-}  // namespace
 
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
                 FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
@@ -146,7 +126,7 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
     // The wall terms only in chunks with mass on W: on a zero wall mass both loops give the same bits.
-    const bool wall = wall_plane && anyBitSet(wall_plane + begin, end - begin);
+    const bool wall = wall_plane && anyNonZero(wall_plane + begin, end - begin);
     kernels::StepInputs chunk_in = in.offset(begin, end - begin);
     if (seeds)
     {

@@ -575,7 +575,7 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const Sc
   const float* pv = betp[FrameMG::kSize - 1].data();
   const float t = static_cast<float>(threshold);
   const float m = static_cast<float>(margin);
-  auto is_moving = [&](std::size_t i) { return pv[i] >= t && pv[i] - ps[i] > m; };
+  auto is_moving = [&](std::size_t i) { return kernels::isMoving(pv[i], ps[i], t, m) != 0; };
   static_assert(kCellChunk == kFusionChunkCells, "the step's seed lists are the chunks of this pass");
   // A region without a moving cell is left alone: only the occupied moving cells seed one. They are found by fixed
   // chunks in parallel and taken in index order, so the regions (disjoint) are the same for any thread count.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "map_aided_fusion/core/rasterizer.hpp"
@@ -412,10 +414,20 @@ void PriorGrid::cellMasses(std::size_t i, const PriorConfidence& beta, float& bu
   other = static_cast<float>(beta.beta_other * (kCoverageSamples - nb - nr) * kInv);
 }
 
-bool PriorWindow::hasWall() const
+bool anyNonZero(const float* p, std::size_t n)
 {
-  return std::any_of(wall.begin(), wall.end(), [](float v) { return v != 0.0f; });
+  constexpr std::uint32_t kMagnitudeBits = 0x7fffffffu;  // a float's bits without its sign
+  std::uint32_t bits = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    std::uint32_t b;
+    std::memcpy(&b, p + i, sizeof b);
+    bits |= b & kMagnitudeBits;
+  }
+  return bits != 0;
 }
+
+bool PriorWindow::hasWall() const { return anyNonZero(wall.data(), wall.size()); }
 
 PriorClass PriorGrid::labelAt(Point2 p) const
 {

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 
 namespace map_aided_fusion {
 
@@ -14,8 +12,6 @@ namespace {
 
 constexpr float kOccupancyScale = 100.0f;
 constexpr std::int8_t kUnknownOccupancy = -1;
-/// A float's bits without its sign: zero for +0 and −0 only.
-constexpr std::uint32_t kMagnitudeBits = 0x7fffffffu;
 
 std::int8_t toOccupancyValue(float p)
 {
@@ -128,23 +124,14 @@ void writeSlot(core::MassGrid<Frame>& grid, int s, const float* src)
   }
 }
 
-/// True when slot @p s of some cell of @p grid is not zero (a NaN counts): an OR over the bit patterns without the
-/// sign for planar slots, which vectorises.
+/// True when slot @p s of some cell of @p grid is not zero (a NaN counts; planar slots: core::anyNonZero()).
 template <class Frame>
 bool anyNonZero(const core::MassGrid<Frame>& grid, int s)
 {
   const std::size_t n = grid.numCells();
   if constexpr (!core::MassGrid<Frame>::kInterleaved)
   {
-    const float* const p = grid.planes() + grid.stride() * static_cast<std::size_t>(s);
-    std::uint32_t bits = 0;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      std::uint32_t b;
-      std::memcpy(&b, p + i, sizeof b);
-      bits |= b & kMagnitudeBits;
-    }
-    return bits != 0;
+    return core::anyNonZero(grid.planes() + grid.stride() * static_cast<std::size_t>(s), n);
   }
   else
   {

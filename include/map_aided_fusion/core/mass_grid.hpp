@@ -213,6 +213,10 @@ private:
 using MapMassGrid = MassGrid<FrameMG>;
 using ScanMassGrid = MassGrid<FrameSG>;
 
+/// True when some of the @p n floats from @p p is not zero (a NaN counts, −0 does not): an OR of the bit patterns
+/// without their sign, which vectorises, unlike a search that stops at the first.
+bool anyNonZero(const float* p, std::size_t n);
+
 /**
  * @brief The prior masses of a window: m(B), m(R), m(T) (equation 1) and m(W = {F, C}) (a cell a building's
  *        outline crosses: occupied there is the wall, the rest of the cell may be free) per cell,
