@@ -268,6 +268,27 @@ MAF_INLINE T scanWithPrior(T sf, T so, T somega, T pb, T pr, T pt, T pw, T (&sp)
   return k;
 }
 
+/**
+ * The step "map conflict" on one cell (see MapGridParams::map_conflict_gain): the doubt @p eta grows by
+ * @p gain · (K − A), K = m_PG(B)·m_SG(F), A = (m_PG(B) + m_PG(W))·m_SG(O), clamped to [0, 1], and the prior masses
+ * are discounted by it (what they lose goes to Ω). Written so that it vectorises.
+ */
+template <typename T>
+MAF_INLINE void mapConflict(T sf, T so, float gain, T& eta, T& pb, T& pr, T& pt, T& pw)
+{
+  const T zero{}, one = splat<T>(1.0f);
+  const T k = pb * sf;
+  const T a = (pb + pw) * so;
+  const T raw = eta + gain * (k - a);
+  const T low = raw < zero ? zero : raw;
+  eta = one < low ? one : low;
+  const T keep = one - eta;
+  pb *= keep;
+  pr *= keep;
+  pt *= keep;
+  pw *= keep;
+}
+
 /// CombinationRule as int, for the kernels.
 constexpr int kRuleModifiedYager = 0;
 constexpr int kRuleYager = 1;

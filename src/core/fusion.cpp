@@ -66,10 +66,35 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
 void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* prior, const FusionParams& params,
                 FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
 {
-  params.validate();
-  if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
   if (prior && prior->geometry != map.geometry())
     throw std::invalid_argument("fusionStep: prior window and map grid differ");
+  StepPrior rows;
+  rows.grid = prior;
+  rows.row_stride = static_cast<std::size_t>(map.geometry().width);
+  fusionStep(map, scan, rows, params, stats, betp, parallel, decisions);
+}
+
+void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& prior, const FusionParams& params,
+                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
+{
+  params.validate();
+  if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
+  const std::size_t width = static_cast<std::size_t>(map.geometry().width);
+  const std::size_t height = static_cast<std::size_t>(map.geometry().height);
+  const PriorWindow* const pg = prior.grid;
+  // The prior's rows: one run of cells per map row when they are not the map's own rows.
+  const bool by_rows = pg && prior.row_stride != width;
+  if (pg)
+  {
+    const std::size_t n = pg->building.size();
+    const bool fits = prior.row_stride >= width && height > 0 &&
+                      prior.first + (height - 1) * prior.row_stride + width <= n && pg->road.size() == n &&
+                      pg->other.size() == n && (pg->wall.size() == n || pg->wall.empty());
+    if (!fits) throw std::invalid_argument("fusionStep: the map's cells are not all inside the prior");
+    if (by_rows && width % MapMassGrid::kBlockCells != 0)
+      throw std::invalid_argument("fusionStep: prior rows need a map width that is a multiple of the blocks");
+  }
+  if (prior.doubt && !pg) throw std::invalid_argument("fusionStep: a map doubt needs a prior");
   const ContextualDiscountWeights<float> w(params.discount);
   kernels::StepInputs in;
   in.base = map.planes();
@@ -77,10 +102,9 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   in.sf = scan.plane(FrameSG::kF);
   in.so = scan.plane(FrameSG::kO);
   in.sw = scan.plane(FrameSG::kOmega);
-  in.pb = prior ? prior->building.data() : nullptr;
-  in.pr = prior ? prior->road.data() : nullptr;
-  in.pt = prior ? prior->other.data() : nullptr;
-  in.pw = prior ? prior->wall.data() : nullptr;
+  in.pb = in.pr = in.pt = in.pw = nullptr;
+  in.eta = prior.doubt;
+  in.conflict_gain = static_cast<float>(prior.conflict_gain);
   in.delta_inc = static_cast<float>(params.counter.delta_inc);
   in.delta_dec = static_cast<float>(params.counter.delta_dec);
   in.gamma_occupied = static_cast<float>(params.counter.gamma_occupied);
@@ -115,25 +139,53 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
     in.decision = decisions->out->data();
   }
   const bool paper = in.rule == kernels::kRuleModifiedYager && in.contextual && in.use_counter;
-  const bool has_prior = prior != nullptr;
-  const float* const wall_plane = prior && prior->wall.size() == in.cells ? prior->wall.data() : nullptr;
+  const bool has_prior = pg != nullptr;
   // Fixed chunks (independent of the thread count), their statistics summed in chunk order: bit-identical results.
   static_assert(kFusionChunkCells % MapMassGrid::kBlockCells == 0, "chunks start on a block of the MapGrid");
   const std::size_t chunks = chunkCount(in.cells, kFusionChunkCells);
   std::vector<FusionStepStats> partial(chunks);
   std::vector<std::vector<std::size_t>>* const seeds = decisions ? decisions->motion_seeds : nullptr;
   if (seeds && seeds->size() < chunks) seeds->resize(chunks);
+  // Cells [begin, end) whose prior is the prior grid's cells from @p at on.
+  auto run = [&](const kernels::StepInputs& chunk_in, std::size_t begin, std::size_t end, std::size_t at,
+                 FusionStepStats& sum) {
+    kernels::StepInputs r = chunk_in.offset(begin, end - begin);
+    bool wall = false;
+    if (pg)
+    {
+      r.pb = pg->building.data() + at;
+      r.pr = pg->road.data() + at;
+      r.pt = pg->other.data() + at;
+      r.pw = pg->wall.empty() ? nullptr : pg->wall.data() + at;
+      // The wall terms only where there is mass on W: on a zero wall mass both loops give the same bits.
+      wall = r.pw && anyNonZero(r.pw, end - begin);
+    }
+    FusionStepStats s;
+    kernels::fusionChunk(r, w, has_prior, wall, paper, s);
+    sum.sum_conflict_free_occupied += s.sum_conflict_free_occupied;
+    sum.sum_conflict_occupied_free += s.sum_conflict_occupied_free;
+    sum.sum_conflict_other += s.sum_conflict_other;
+    sum.num_cells += s.num_cells;
+  };
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
-    // The wall terms only in chunks with mass on W: on a zero wall mass both loops give the same bits.
-    const bool wall = wall_plane && anyNonZero(wall_plane + begin, end - begin);
-    kernels::StepInputs chunk_in = in.offset(begin, end - begin);
+    kernels::StepInputs chunk_in = in;
     if (seeds)
     {
       (*seeds)[c].clear();
       chunk_in.seeds = &(*seeds)[c];
     }
-    kernels::fusionChunk(chunk_in, w, has_prior, wall, paper, partial[c]);
+    if (!by_rows)
+    {
+      run(chunk_in, begin, end, prior.first + begin, partial[c]);
+      return;
+    }
+    for (std::size_t i = begin; i < end;)
+    {
+      const std::size_t y = i / width, row_end = std::min(end, (y + 1) * width);
+      run(chunk_in, i, row_end, prior.first + y * prior.row_stride + (i - y * width), partial[c]);
+      i = row_end;
+    }
   };
   orSerial(parallel).forChunks(chunks, chunk);
   FusionStepStats total;

@@ -61,9 +61,16 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
     loadMasses(base, i, m);
     T sp[kNumScanPrior];
     const T zero{};
-    scanWithPrior(load<T>(in.sf + i), load<T>(in.so + i), load<T>(in.sw + i), kHasPrior ? load<T>(in.pb + i) : zero,
-                  kHasPrior ? load<T>(in.pr + i) : zero, kHasPrior ? load<T>(in.pt + i) : zero,
-                  kWall ? load<T>(in.pw + i) : zero, sp, in.threshold);
+    const T sf = load<T>(in.sf + i), so = load<T>(in.so + i);
+    T pb = kHasPrior ? load<T>(in.pb + i) : zero, pr = kHasPrior ? load<T>(in.pr + i) : zero;
+    T pt = kHasPrior ? load<T>(in.pt + i) : zero, pw = kWall ? load<T>(in.pw + i) : zero;
+    if (kHasPrior && in.eta)
+    {
+      T eta = load<T>(in.eta + i);
+      mapConflict(sf, so, in.conflict_gain, eta, pb, pr, pt, pw);
+      store(in.eta + i, eta);
+    }
+    scanWithPrior(sf, so, load<T>(in.sw + i), pb, pr, pt, pw, sp, in.threshold);
     if (kPaper || in.contextual)
       contextualDiscount(m, weightsFor<T>(w, w8, lane));
     else

@@ -36,6 +36,8 @@ struct StepInputs
   const float* pr;
   const float* pt;
   const float* pw;
+  float* eta;           ///< the map doubt η to update and discount the prior by (step map_conflict), or nullptr
+  float conflict_gain;  ///< MapGridParams::map_conflict_gain
   float delta_inc, delta_dec, gamma_occupied, gamma_conflict, threshold;
   bool literal;
   int rule;
@@ -50,7 +52,7 @@ struct StepInputs
   std::size_t first;                ///< index of the first cell in the whole grid (what the seeds record)
 
   /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved. @p begin must start a block
-  /// of the MapGrid (a multiple of MapMassGrid::kBlockCells).
+  /// of the MapGrid (a multiple of MapMassGrid::kBlockCells). The prior pointers are the caller's (rows of the prior).
   StepInputs offset(std::size_t begin, std::size_t count) const
   {
     StepInputs o = *this;
@@ -61,10 +63,7 @@ struct StepInputs
     move(o.sf);
     move(o.so);
     move(o.sw);
-    move(o.pb);
-    move(o.pr);
-    move(o.pt);
-    move(o.pw);
+    move(o.eta);
     for (auto*& b : o.betp) move(b);
     move(o.decision);
     o.first += begin;
@@ -73,7 +72,7 @@ struct StepInputs
   }
 };
 
-/// The fused step on the cells of @p in (one chunk): masses, ζ, BetP and decisions in place, conflicts summed into
+/// The fused step on the cells of @p in (one run of cells of one prior row, or of a chunk without prior): masses, ζ, BetP and decisions in place, conflicts summed into
 /// @p out.
 void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w, bool has_prior, bool wall, bool paper,
                  FusionStepStats& out);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "map_aided_fusion/core/parameters.hpp"
@@ -20,8 +21,7 @@ namespace {
 constexpr int kMaxWindowCells = 8192;
 /// Side of the square tiles projectScan() walks the window in, cells.
 constexpr int kProjectTile = 32;
-constexpr std::size_t kClearanceRows = 64;     // rows per chunk of the clearance's row pass
-constexpr std::size_t kClearanceColumns = 256;  // columns per chunk of its column pass
+constexpr std::size_t kClearanceRows = 64;     // rows per chunk of the clearance's passes
 constexpr std::size_t kCellChunk = 16384;      // cells per chunk of the per-cell passes (whole MapGrid blocks)
 static_assert(kCellChunk % MapMassGrid::kBlockCells == 0, "chunks start on a block");
 constexpr std::size_t kPriorRows = 32;         // rows per chunk of the prior window's copy
@@ -160,15 +160,21 @@ void sampleRun(ScanPlanes scan, int scan_width, double fxr, double fyr, double d
   }
 }
 
-/// The free mass of the cells [0, n) whose @p count is positive goes to Ω.
-void clearFree(const int* count, std::size_t n, float* __restrict f, float* __restrict omega)
+/// The free mass of the cells [0, n) whose @p near is set goes to Ω.
+void clearFree(const std::uint8_t* __restrict near, std::size_t n, float* __restrict f, float* __restrict omega)
 {
   for (std::size_t x = 0; x < n; ++x)
   {
-    const bool clear = count[x] > 0;
+    const bool clear = near[x] != 0;
     omega[x] = clear ? omega[x] + f[x] : omega[x];
     f[x] = clear ? 0.0f : f[x];
   }
+}
+
+/// out[x] |= row[x] for x in [0, n).
+void orRow(const std::uint8_t* __restrict row, std::size_t n, std::uint8_t* __restrict out)
+{
+  for (std::size_t x = 0; x < n; ++x) out[x] |= row[x];
 }
 
 }  // namespace
@@ -329,9 +335,9 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
     }
   if (clearance_cells <= 0) return;
   // Obstacle clearance: no free evidence within clearance_cells (square) of an occupied cell. Separable: a row pass
-  // marks the cells within k columns of an occupied cell (an OR of 2k + 1 shifted rows of bytes), then a running count
-  // down each strip of columns. Both vectorise, are linear in the window whatever the number of occupied cells, and
-  // rows, then column strips, are independent chunks.
+  // marks the cells within k columns of an occupied cell (an OR of 2k + 1 shifted rows of bytes), then a column pass
+  // ORs the 2k + 1 marked rows around each row. Both vectorise, are linear in the window whatever the number of
+  // occupied cells, and take bands of rows as independent chunks.
   thread_local std::vector<std::uint8_t> rows;
   const std::size_t n = window.numCells();
   const std::size_t ws = static_cast<std::size_t>(w);
@@ -352,24 +358,19 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
         for (int x = std::max(0, -d), x1 = std::min(w, w - d); x < x1; ++x) r[x] |= occ[x + d];
     }
   });
-  par.forRange(ws, kClearanceColumns, [&](std::size_t x0, std::size_t x1) {
-    int column[kClearanceColumns] = {};
-    const std::size_t cw = x1 - x0;
-    for (int y = 0; y < std::min(h, k); ++y)
-      for (std::size_t x = 0; x < cw; ++x) column[x] += near[static_cast<std::size_t>(y) * ws + x0 + x];
-    for (int y = 0; y < h; ++y)
+  // Column pass, row after row: a cell is near an obstacle when the row pass marked it in one of the 2k + 1 rows
+  // around it (an OR of byte rows), so each band of rows streams through the planes in memory order.
+  par.forRange(static_cast<std::size_t>(h), kClearanceRows, [&](std::size_t y0, std::size_t y1) {
+    thread_local std::vector<std::uint8_t> band;
+    band.resize(ws);
+    std::uint8_t* const any = band.data();
+    for (std::size_t y = y0; y < y1; ++y)
     {
-      if (y + k < h)
-      {
-        const std::uint8_t* add = near + static_cast<std::size_t>(y + k) * ws + x0;
-        for (std::size_t x = 0; x < cw; ++x) column[x] += add[x];
-      }
-      if (y - k - 1 >= 0)
-      {
-        const std::uint8_t* sub = near + static_cast<std::size_t>(y - k - 1) * ws + x0;
-        for (std::size_t x = 0; x < cw; ++x) column[x] -= sub[x];
-      }
-      clearFree(column, cw, df + static_cast<std::size_t>(y) * ws + x0, dw + static_cast<std::size_t>(y) * ws + x0);
+      std::fill(any, any + ws, std::uint8_t{ 0 });
+      const std::size_t from = y >= static_cast<std::size_t>(k) ? y - static_cast<std::size_t>(k) : 0;
+      const std::size_t to = std::min(static_cast<std::size_t>(h), y + static_cast<std::size_t>(k) + 1);
+      for (std::size_t r = from; r < to; ++r) orRow(near + r * ws, ws, any);
+      clearFree(any, ws, df + y * ws, dw + y * ws);
     }
   });
 }
@@ -384,20 +385,7 @@ void conflictCells(PriorWindow& prior, const float* __restrict sf, const float* 
   float* __restrict r = prior.road.data();
   float* __restrict t = prior.other.data();
   float* __restrict wall = prior.wall.data();
-  for (std::size_t i = i0; i < i1; ++i)
-  {
-    const float k = b[i] * sf[i];
-    const float a = (b[i] + wall[i]) * so[i];
-    const float raw = eta_out[i] + g * (k - a);
-    const float low = raw < 0.0f ? 0.0f : raw;
-    const float eta = 1.0f < low ? 1.0f : low;  // std::clamp(raw, 0, 1), written so that it vectorises
-    eta_out[i] = eta;
-    const float keep = 1.0f - eta;
-    b[i] *= keep;
-    r[i] *= keep;
-    t[i] *= keep;
-    wall[i] *= keep;
-  }
+  for (std::size_t i = i0; i < i1; ++i) kernels::mapConflict(sf[i], so[i], g, eta_out[i], b[i], r[i], t[i], wall[i]);
 }
 
 void extractPriorRows(const PriorWindow& prior, const GridGeometry& window, PriorWindow& out,
@@ -898,6 +886,55 @@ void applyMapConflict(PriorWindow& prior, const ScanMassGrid& scan, double gain,
                [&](std::size_t i0, std::size_t i1) { conflictCells(prior, sf, so, g, eta_out, i0, i1); });
 }
 
+namespace {
+
+/// The column (or row) of @p prior's lattice under the centre of cell @p k of a window starting at @p window_origin.
+long priorLine(double window_origin, double window_res, int k, double prior_origin, double prior_res)
+{
+  const double c = window_origin + (k + 0.5) * window_res;
+  return static_cast<long>(std::floor((c - prior_origin) / prior_res));
+}
+
+}  // namespace
+
+std::optional<std::size_t> alignedPriorStart(const GridGeometry& prior, const GridGeometry& window)
+{
+  if (window.width <= 0 || window.height <= 0) return std::nullopt;
+  // extractPriorWindow's nearest-neighbour sampling, cell by cell: every column and row must map to consecutive ones.
+  auto consecutive = [](double wo, double wr, int n, double po, double pr, int pn) -> std::optional<long> {
+    const long first = priorLine(wo, wr, 0, po, pr);
+    if (first < 0 || first + n > pn) return std::nullopt;
+    for (int k = 1; k < n; ++k)
+      if (priorLine(wo, wr, k, po, pr) != first + k) return std::nullopt;
+    return first;
+  };
+  const auto x0 = consecutive(window.origin_x, window.resolution, window.width, prior.origin_x, prior.resolution,
+                              prior.width);
+  const auto y0 = x0 ? consecutive(window.origin_y, window.resolution, window.height, prior.origin_y, prior.resolution,
+                                   prior.height)
+                     : std::nullopt;
+  if (!y0) return std::nullopt;
+  return static_cast<std::size_t>(*y0) * static_cast<std::size_t>(prior.width) + static_cast<std::size_t>(*x0);
+}
+
+void MapGrid::priorWindow(const PriorWindow* prior, PriorWindow& out) const
+{
+  const GridGeometry& g = grid_.geometry();
+  if (!prior)
+  {
+    out.reset(g);
+    return;
+  }
+  extractPriorWindow(*prior, g, out, parallel_.get());
+  if (params_.map_conflict_gain <= 0.0 || map_doubt_.size() != g.numCells()) return;
+  const float* const eta = map_doubt_.data();
+  float* const planes[4] = { out.building.data(), out.road.data(), out.other.data(), out.wall.data() };
+  parallel_->forRange(g.numCells(), kCellChunk, [&](std::size_t i0, std::size_t i1) {
+    for (float* p : planes)
+      for (std::size_t i = i0; i < i1; ++i) p[i] *= 1.0f - eta[i];
+  });
+}
+
 void MapGrid::recentre(Point2 p)
 {
   const GridGeometry& g = grid_.geometry();
@@ -934,13 +971,30 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   t.project_scan = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
+  const GridGeometry& window = grid_.geometry();
+  StepPrior step_prior;
   if (prior)
   {
-    if (params_.map_conflict_gain > 0.0)
-      extractPriorWindow(*prior, grid_.geometry(), prior_window_,
-                         MapConflict{ &scan_window_, params_.map_conflict_gain, &map_doubt_ }, parallel_.get());
+    // The step reads the prior's own rows when the window lies inside it on its lattice; otherwise its window is
+    // sampled first (the same values: a nearest-neighbour copy of the same cells).
+    const std::optional<std::size_t> at = alignedPriorStart(prior->geometry, window);
+    if (at && (prior->geometry.width == window.width || window.width % MapMassGrid::kBlockCells == 0))
+    {
+      step_prior.grid = prior;
+      step_prior.first = *at;
+      step_prior.row_stride = static_cast<std::size_t>(prior->geometry.width);
+    }
     else
-      extractPriorWindow(*prior, grid_.geometry(), prior_window_, parallel_.get());
+    {
+      extractPriorWindow(*prior, window, prior_window_, parallel_.get());
+      step_prior.grid = &prior_window_;
+      step_prior.row_stride = static_cast<std::size_t>(window.width);
+    }
+    if (params_.map_conflict_gain > 0.0)
+    {
+      step_prior.doubt = map_doubt_.data();
+      step_prior.conflict_gain = params_.map_conflict_gain;
+    }
   }
   t.prior_window = secondsSince(t0);
 
@@ -953,7 +1007,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   decisions.threshold = params_.decision_threshold;
   decisions.motion_margin = params_.motion_margin;
   if (params_.motion_share > 0.0) decisions.motion_seeds = &motion_seeds_;
-  fusionStep(grid_, scan_window_, prior ? &prior_window_ : nullptr, fp, &stats, &betp_, parallel_.get(), &decisions);
+  fusionStep(grid_, scan_window_, step_prior, fp, &stats, &betp_, parallel_.get(), &decisions);
   const std::vector<std::size_t>* spread = nullptr;
   spreadMotionCells(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells,
                     params_.decision_threshold, params_.motion_margin, parallel_.get(), &motion_seeds_, spread);

@@ -484,11 +484,11 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   std_msgs::Header header;
   header.stamp = msg->header.stamp;
   header.frame_id = node_params_.map_frame;
-  publish(header);
+  publish(header, prior);
   last_total_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 
-void FusionWorker::publish(const std_msgs::Header& header)
+void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWindow* prior)
 {
   const auto& grid = grid_.masses();
   if (map_grid_pub_.getNumSubscribers() > 0)
@@ -521,7 +521,9 @@ void FusionWorker::publish(const std_msgs::Header& header)
   if (navigable_pub_.getNumSubscribers() > 0)
   {
     std::vector<std::int8_t> navigable;
-    core::navigableLayer(decision, grid_.priorWindow(), navigable);
+    core::PriorWindow prior_window;
+    grid_.priorWindow(prior, prior_window);
+    core::navigableLayer(decision, prior_window, navigable);
     publishLayer(navigable_pub_, navigable);
   }
   if (cells_pub_.getNumSubscribers() > 0)

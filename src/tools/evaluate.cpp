@@ -199,6 +199,7 @@ struct Variant
   bool use_prior;
   core::PriorGridOptions prior_options;
   core::PriorSoftener softener;
+  const core::PriorWindow* last_prior = nullptr;  // the softener's prior given to the last update
   eval::ClassGrid decision;
   eval::PointLabelScorer points;
   Variant(const std::string& name, const std::string& description, const core::Profile& profile, bool prior,
@@ -628,6 +629,7 @@ int main(int argc, char** argv)
         if (auto c = covariance_sigma.upper_bound(k); c != covariance_sigma.begin()) sigma = std::prev(c)->second;
         const core::PriorWindow* pw = v->use_prior ? v->softener.softened(sigma) : nullptr;
         v->grid.update(v->scan, pose, t, pw, nullptr, &obstacles);
+        v->last_prior = pw;
         v->decision.geometry = v->grid.geometry();
         v->decision.cells = v->grid.decisions();
         if (point_mode)
@@ -717,7 +719,8 @@ int main(int argc, char** argv)
           if (prior)
           {
             const auto& g = variants[0]->grid.geometry();
-            const core::PriorWindow& w = variants[0]->grid.priorWindow();
+            core::PriorWindow w;
+            variants[0]->grid.priorWindow(variants[0]->last_prior, w);
             std::vector<std::int8_t> labels(g.numCells());
             for (std::size_t i = 0; i < labels.size(); ++i)
             {

@@ -334,6 +334,112 @@ TEST(ExtractPriorWindow, MapConflictInTheSamePassEqualsTheTwoSteps)
   EXPECT_THROW(extractPriorWindow(prior, GridGeometry::centred(8.0, 8.0, kRes), out, mismatched), std::invalid_argument);
 }
 
+TEST(AlignedPriorStart, IsTheIndexOfTheWindowsFirstCellOnlyWhenTheWholeWindowLiesOnThePriorsLattice)
+{
+  const GridGeometry prior = GridGeometry::centred(30.0, 20.0, kRes);  // 60 × 40 cells, origin (−15, −10)
+  const GridGeometry inside = GridGeometry::centred(8.0, 4.0, kRes, 2.0, -1.0);  // origin (−2, −3): cell (26, 14)
+  ASSERT_TRUE(alignedPriorStart(prior, inside).has_value());
+  EXPECT_EQ(*alignedPriorStart(prior, inside), 14u * 60u + 26u);
+  EXPECT_EQ(*alignedPriorStart(prior, prior), 0u);
+  EXPECT_FALSE(alignedPriorStart(prior, GridGeometry::centred(8.0, 4.0, kRes, 12.0, 0.0)));  // over the right edge
+  EXPECT_FALSE(alignedPriorStart(prior, GridGeometry::centred(8.0, 4.0, kRes, 0.0, -9.0)));  // below the first row
+  EXPECT_FALSE(alignedPriorStart(prior, GridGeometry::centred(8.0, 4.0, kRes / 2.0)));       // twice as fine
+  // A window off the lattice by less than half a cell samples the same cells: still consecutive.
+  const GridGeometry off = GridGeometry::centred(8.0, 4.0, kRes, 2.0 + kRes / 3.0, -1.0);
+  EXPECT_EQ(alignedPriorStart(prior, off), alignedPriorStart(prior, inside));
+}
+
+TEST(FusionStep, ReadingThePriorsRowsWithItsDoubtEqualsTheExtractedWindowWithItsConflict)
+{
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  PriorWindow prior(GridGeometry::centred(40.0, 30.0, kRes));  // 80 × 60 cells
+  for (std::size_t i = 0; i < prior.building.size(); ++i)
+  {
+    const float total = 0.95f * u(rng);
+    const int kind = static_cast<int>(rng() % 4);
+    (kind == 0 ? prior.building : kind == 1 ? prior.road : kind == 2 ? prior.other : prior.wall)[i] = total;
+  }
+  const GridGeometry window = GridGeometry::centred(16.0, 12.0, kRes, 3.0, -2.0);  // 32 × 24 cells
+  const auto first = alignedPriorStart(prior.geometry, window);
+  ASSERT_TRUE(first.has_value());
+  FusionParams params;
+  constexpr double kGain = 0.3;
+  const std::size_t floats =
+      (window.numCells() + MapMassGrid::kBlockCells - 1) / MapMassGrid::kBlockCells * MapMassGrid::kBlockFloats;
+  // Three ways to the same step: the prior's rows (MapGrid::update); its window copied, the doubt in the step (the
+  // update's fallback); the window discounted by applyMapConflict() first (the two public steps).
+  struct Path
+  {
+    MapMassGrid map;
+    AlignedVector<float> doubt;
+    PignisticPlanes betp;
+    std::vector<std::int8_t> decision;
+  };
+  for (int threads : { 1, 2 })
+  {
+    const Parallel parallel(threads);
+    Path rows{ MapMassGrid(window), AlignedVector<float>(window.numCells(), 0.05f), {}, {} };
+    Path copied = rows, separate = rows;
+    std::mt19937 scans(3);
+    for (int step = 0; step < 4; ++step)
+    {
+      ScanMassGrid scan(window);
+      for (std::size_t i = 0; i < scan.numCells(); ++i) scan.setCell(i, maf_test::randomMass<FrameSG>(scans, 3));
+      auto run = [&](Path& p, const StepPrior& sp) {
+        StepDecisions d;
+        d.out = &p.decision;
+        FusionStepStats s;
+        fusionStep(p.map, scan, sp, params, &s, &p.betp, &parallel, &d);
+        return s;
+      };
+      StepPrior by_rows{ &prior, *first, static_cast<std::size_t>(prior.geometry.width), rows.doubt.data(), kGain };
+      const FusionStepStats s_rows = run(rows, by_rows);
+      PriorWindow w;
+      extractPriorWindow(prior, window, w);
+      const FusionStepStats s_copied =
+          run(copied, StepPrior{ &w, 0, static_cast<std::size_t>(window.width), copied.doubt.data(), kGain });
+      extractPriorWindow(prior, window, w, MapConflict{ &scan, kGain, &separate.doubt });
+      StepDecisions d;
+      d.out = &separate.decision;
+      FusionStepStats s_separate;
+      fusionStep(separate.map, scan, &w, params, &s_separate, &separate.betp, &parallel, &d);
+      EXPECT_EQ(s_rows.num_cells, window.numCells());
+      EXPECT_NEAR(s_rows.meanConflict(), s_copied.meanConflict(), 1e-6);
+      EXPECT_NEAR(s_rows.meanConflict(), s_separate.meanConflict(), 1e-5);
+    }
+    float largest = 0.0f;
+    for (float e : rows.doubt) largest = std::max(largest, e);
+    EXPECT_GT(largest, 0.05f) << "the scans must raise the doubt somewhere";
+    // The same kernel: the same bits.
+    EXPECT_EQ(std::memcmp(rows.doubt.data(), copied.doubt.data(), rows.doubt.size() * sizeof(float)), 0) << threads;
+    EXPECT_EQ(std::memcmp(rows.map.planes(), copied.map.planes(), floats * sizeof(float)), 0) << threads;
+    for (int e = 0; e < FrameMG::kSize; ++e)
+      EXPECT_EQ(std::memcmp(rows.betp[e].data(), copied.betp[e].data(), window.numCells() * sizeof(float)), 0) << e;
+    EXPECT_EQ(rows.decision, copied.decision);
+    // The separate steps: the same up to the rounding of η (contracted into an FMA or not).
+    for (std::size_t i = 0; i < window.numCells(); ++i)
+    {
+      EXPECT_NEAR(rows.doubt[i], separate.doubt[i], 1e-6) << i;
+      for (int e = 0; e < FrameMG::kSize; ++e) EXPECT_NEAR(rows.betp[e][i], separate.betp[e][i], 1e-5) << i;
+    }
+    for (std::size_t f = 0; f < floats; ++f) ASSERT_NEAR(rows.map.planes()[f], separate.map.planes()[f], 1e-5) << f;
+  }
+  // Rows of another width need whole blocks per row; and the window must lie inside the prior.
+  const GridGeometry odd = GridGeometry::centred(16.5, 12.0, kRes, 3.0, -2.0);  // 33 cells a row
+  MapMassGrid m(odd);
+  ScanMassGrid scan(odd);
+  StepPrior rows;
+  rows.grid = &prior;
+  rows.first = *alignedPriorStart(prior.geometry, odd);
+  rows.row_stride = static_cast<std::size_t>(prior.geometry.width);
+  EXPECT_THROW(fusionStep(m, scan, rows, params), std::invalid_argument);
+  MapMassGrid big(window);
+  ScanMassGrid big_scan(window);
+  rows.first = prior.building.size() - 10;
+  EXPECT_THROW(fusionStep(big, big_scan, rows, params), std::invalid_argument);
+}
+
 TEST(ExtractPriorWindow, CopiesAlignedCellsAndIsVacuousOutside)
 {
   const PriorWindow prior = scriptedPrior();

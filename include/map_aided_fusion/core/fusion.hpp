@@ -120,6 +120,32 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
                 FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr, const Parallel* parallel = nullptr,
                 const StepDecisions* decisions = nullptr);
 
+/**
+ * @brief The prior as the fused step reads it (MapGrid::update): the rows of a prior grid that holds the map's cells
+ *        on the same lattice, so that no prior window is copied, and the step "map conflict" applied cell by cell.
+ */
+struct StepPrior
+{
+  const PriorWindow* grid = nullptr;  ///< the prior; its cell @p first is the map's cell (0, 0)
+  std::size_t first = 0;              ///< index in @p grid of the map's cell (0, 0)
+  /// Cells from one row of the map to the next in @p grid (its width); when it differs from the map's width, that
+  /// width must be a multiple of MapMassGrid::kBlockCells.
+  std::size_t row_stride = 0;
+  /// When not null: the map doubt η of each map cell, updated, by which the prior is discounted before it is combined
+  /// (applyMapConflict() in map_grid.hpp, with the same scan); nullptr: the prior as it is.
+  float* doubt = nullptr;
+  double conflict_gain = 0.0;  ///< MapGridParams::map_conflict_gain
+};
+
+/**
+ * @brief fusionStep() with the prior read from @p prior's rows (and its map doubt): the same masses, ζ, BetP and
+ *        decisions as extractPriorWindow(), applyMapConflict() and fusionStep() on that window.
+ * @throws std::invalid_argument when the map's cells are not all inside @p prior.grid, or the widths do not allow it.
+ */
+void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& prior, const FusionParams& params,
+                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr, const Parallel* parallel = nullptr,
+                const StepDecisions* decisions = nullptr);
+
 /// Cells per chunk of a parallel fusion step (a multiple of the 8-cell vectors and of the prefetch blocks).
 constexpr std::size_t kFusionChunkCells = 16384;
 

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -216,6 +217,12 @@ void extractPriorWindow(const PriorWindow& prior, const GridGeometry& window, Pr
                         const MapConflict& conflict, const Parallel* parallel = nullptr);
 
 /**
+ * @brief Where the window's cell (0, 0) is in @p prior (its index) when extractPriorWindow() would copy the window as
+ *        consecutive columns and rows of @p prior, all inside it; nullopt otherwise.
+ */
+std::optional<std::size_t> alignedPriorStart(const GridGeometry& prior, const GridGeometry& window);
+
+/**
  * @brief The navigable-space layer (nav_msgs/OccupancyGrid values) from a decision grid and the prior of the same
  *        cells: free on the road surface (m_PG(R) above m_PG(T) + m_PG(B) + m_PG(W)) → 0; free elsewhere or where
  *        the prior is vacuous → kNavigableOffRoad; occupied (C, N, S, V, or occupied undetermined) → 100;
@@ -314,8 +321,12 @@ public:
   std::size_t scans() const { return scans_; }
   /// The map doubt η of every window cell (step map_conflict; zeros when it is off).
   const AlignedVector<float>& mapDoubt() const { return map_doubt_; }
-  /// The prior window of the last update, after the map doubt (vacuous without a prior).
-  const PriorWindow& priorWindow() const { return prior_window_; }
+  /**
+   * @brief The prior of the last update in the window's cells, after the map doubt: @p prior, the PriorGrid given to
+   *        that update, sampled at each cell (extractPriorWindow()) and discounted by mapDoubt() as the step was;
+   *        vacuous when @p prior is null.
+   */
+  void priorWindow(const PriorWindow* prior, PriorWindow& out) const;
   /// The threads of this grid's update (MapGridParams::threads), for the decisions of the same cells.
   const Parallel& parallel() const { return *parallel_; }
 
@@ -323,7 +334,7 @@ private:
   MapGridParams params_;
   MapMassGrid grid_;
   ScanMassGrid scan_window_;
-  PriorWindow prior_window_;
+  PriorWindow prior_window_;  // the prior sampled at the window's cells, when the step cannot read the prior's rows
   AlignedVector<float> map_doubt_;
   PignisticPlanes betp_;
   std::vector<std::int8_t> decision_;

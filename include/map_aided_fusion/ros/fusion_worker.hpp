@@ -103,7 +103,8 @@ private:
   /// A pose covariance (6 × 6 row-major): a new σ, or a counted, throttled rejection keeping the last good σ.
   void onCovariance(const boost::array<double, 36>& covariance);
   void onReconfigure(FusionConfig& config, uint32_t level);
-  void publish(const std_msgs::Header& header);
+  /// Publishes the layers of the last update, whose prior was @p prior (nullptr: none).
+  void publish(const std_msgs::Header& header, const core::PriorWindow* prior);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
