@@ -147,13 +147,16 @@ struct ScanPlanes
 /// Window cells [x0, x1) of one row, all inside the scan grid: each takes the scan cell under (fxr + x dfx,
 /// fyr + x dfy) (scan cells); with @p points the occupied mass goes to Ω (point occupancy marks it later).
 MAF_TARGET_CLONES
-void sampleRun(ScanPlanes scan, int scan_width, double fxr, double fyr, double dfx, double dfy, int x0, int x1,
-               bool points, float* __restrict f, float* __restrict o, float* __restrict omega)
+void sampleRun(ScanPlanes scan, int scan_width, int scan_height, double fxr, double fyr, double dfx, double dfy, int x0,
+               int x1, bool points, float* __restrict f, float* __restrict o, float* __restrict omega)
 {
   for (int x = x0; x < x1; ++x)
   {
     const double fx = fxr + x * dfx, fy = fyr + x * dfy;
-    const int i = static_cast<int>(fy) * scan_width + static_cast<int>(fx);
+    // The row interval's test rounds fx and fy without FMA; a clone that contracts them may land one rounding past
+    // the scan grid's last column or row: the index is kept inside.
+    const int ix = std::min(static_cast<int>(fx), scan_width - 1), iy = std::min(static_cast<int>(fy), scan_height - 1);
+    const int i = iy * scan_width + ix;
     f[x] = scan.f[i];
     o[x] = points ? 0.0f : scan.o[i];
     omega[x] = points ? scan.omega[i] + scan.o[i] : scan.omega[i];
@@ -273,8 +276,8 @@ void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry
         const int x_end = std::min({ w, tx + kProjectTile, hi[y - ty] });
         const int x0 = std::max(tx, lo[y - ty]);
         if (x0 < x_end)
-          sampleRun(ScanPlanes{ sf, s_o, sw }, sg.width, fxr[y - ty], fyr[y - ty], dfx, dfy, x0, x_end, points,
-                    df + row, d_o + row, dw + row);
+          sampleRun(ScanPlanes{ sf, s_o, sw }, sg.width, sg.height, fxr[y - ty], fyr[y - ty], dfx, dfy, x0, x_end,
+                    points, df + row, d_o + row, dw + row);
       }
   });
   // Occupancy marks: the occupied cells (or returns) and the window cell under each are found by fixed chunks in

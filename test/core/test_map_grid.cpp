@@ -440,6 +440,32 @@ TEST(FusionStep, ReadingThePriorsRowsWithItsDoubtEqualsTheExtractedWindowWithIts
   EXPECT_THROW(fusionStep(big, big_scan, rows, params), std::invalid_argument);
 }
 
+TEST(MapGrid, PriorWindowIsThePriorOfTheUpdateDiscountedByTheMapDoubt)
+{
+  MapGridParams params;
+  params.size_x = params.size_y = 8.0;
+  params.resolution = kRes;
+  params.recentre_distance = 1.0;
+  MapGrid grid(params);
+  PriorWindow prior(GridGeometry::centred(20.0, 20.0, kRes));
+  std::fill(prior.building.begin(), prior.building.end(), 0.9f);  // a mapped building the lidar sees through
+  ScanMassGrid scan(GridGeometry::centred(8.0, 8.0, kRes));
+  for (std::size_t i = 0; i < scan.numCells(); ++i) scan.setCell(i, kFreeScan);
+  for (int k = 0; k < 3; ++k) grid.update(scan, Pose2{}, 0.1 * k, &prior);
+  PriorWindow w;
+  grid.priorWindow(&prior, w);
+  ASSERT_EQ(w.geometry, grid.geometry());
+  const AlignedVector<float>& doubt = grid.mapDoubt();
+  for (std::size_t i = 0; i < w.building.size(); ++i)
+  {
+    EXPECT_NEAR(doubt[i], 3 * 0.2 * 0.9 * 0.7, 1e-5) << i;
+    EXPECT_EQ(w.building[i], 0.9f * (1.0f - doubt[i])) << i;
+    EXPECT_EQ(w.road[i] + w.other[i] + w.wall[i], 0.0f) << i;
+  }
+  grid.priorWindow(nullptr, w);
+  for (std::size_t i = 0; i < w.building.size(); ++i) EXPECT_EQ(w.building[i], 0.0f) << i;
+}
+
 TEST(ExtractPriorWindow, CopiesAlignedCellsAndIsVacuousOutside)
 {
   const PriorWindow prior = scriptedPrior();
