@@ -62,7 +62,8 @@ void BM_MapGridUpdate(benchmark::State& state)
     sum.fusion += st.fusion;
     benchmark::ClobberMemory();
   }
-  // Mean milliseconds per scan of each stage (the fusion stage includes BetP, the decisions and motion spreading).
+  // Mean milliseconds per scan of each stage: project_ms is the projection's plan; the fusion stage includes the scan's
+  // samples (written chunk by chunk by the fused step), BetP, the decisions and motion spreading.
   const double k = 1e3 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["shift_ms"] = sum.shift * k;
   state.counters["project_ms"] = sum.project_scan * k;

@@ -74,11 +74,18 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const PriorWindow* p
   fusionStep(map, scan, rows, params, stats, betp, parallel, decisions);
 }
 
-void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& prior, const FusionParams& params,
-                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
+namespace {
+
+constexpr std::size_t kScanPlanes = 3;  // F, O and Ω of a chunk's scan buffer
+
+/// fusionStep() with the scan's planes in the map's cells (@p scan) or filled chunk by chunk (@p cells).
+void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, const StepPrior& prior,
+          const FusionParams& params, FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel,
+          const StepDecisions* decisions)
 {
   params.validate();
-  if (scan.geometry() != map.geometry()) throw std::invalid_argument("fusionStep: scan grid and map grid differ");
+  if ((scan ? scan->geometry() : cells->geometry()) != map.geometry())
+    throw std::invalid_argument("fusionStep: scan grid and map grid differ");
   const std::size_t width = static_cast<std::size_t>(map.geometry().width);
   const std::size_t height = static_cast<std::size_t>(map.geometry().height);
   const PriorWindow* const pg = prior.grid;
@@ -99,9 +106,9 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& pri
   kernels::StepInputs in;
   in.base = map.planes();
   in.cells = map.numCells();
-  in.sf = scan.plane(FrameSG::kF);
-  in.so = scan.plane(FrameSG::kO);
-  in.sw = scan.plane(FrameSG::kOmega);
+  in.sf = scan ? scan->plane(FrameSG::kF) : nullptr;
+  in.so = scan ? scan->plane(FrameSG::kO) : nullptr;
+  in.sw = scan ? scan->plane(FrameSG::kOmega) : nullptr;
   in.pb = in.pr = in.pt = in.pw = nullptr;
   in.eta = prior.doubt;
   in.conflict_gain = static_cast<float>(prior.conflict_gain);
@@ -146,10 +153,17 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& pri
   std::vector<FusionStepStats> partial(chunks);
   std::vector<std::vector<std::size_t>>* const seeds = decisions ? decisions->motion_seeds : nullptr;
   if (seeds && seeds->size() < chunks) seeds->resize(chunks);
-  // Cells [begin, end) whose prior is the prior grid's cells from @p at on.
+  // Cells [begin, end) whose prior is the prior grid's cells from @p at on; with @p local, their scan masses are
+  // the chunk's buffer from cell @p chunk_begin on (F, O, Ω planes of kFusionChunkCells).
   auto run = [&](const kernels::StepInputs& chunk_in, std::size_t begin, std::size_t end, std::size_t at,
-                 FusionStepStats& sum) {
+                 FusionStepStats& sum, const float* local, std::size_t chunk_begin) {
     kernels::StepInputs r = chunk_in.offset(begin, end - begin);
+    if (local)
+    {
+      r.sf = local + (begin - chunk_begin);
+      r.so = r.sf + kFusionChunkCells;
+      r.sw = r.so + kFusionChunkCells;
+    }
     bool wall = false;
     if (pg)
     {
@@ -175,15 +189,23 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& pri
       (*seeds)[c].clear();
       chunk_in.seeds = &(*seeds)[c];
     }
+    float* local = nullptr;
+    if (cells)
+    {
+      thread_local AlignedVector<float> buffer;  // the fusing thread's (a worker's own in a parallel step)
+      if (buffer.size() < kScanPlanes * kFusionChunkCells) buffer.resize(kScanPlanes * kFusionChunkCells);
+      local = buffer.data();
+      cells->fill(begin, end, local, local + kFusionChunkCells, local + 2 * kFusionChunkCells);
+    }
     if (!by_rows)
     {
-      run(chunk_in, begin, end, prior.first + begin, partial[c]);
+      run(chunk_in, begin, end, prior.first + begin, partial[c], local, begin);
       return;
     }
     for (std::size_t i = begin; i < end;)
     {
       const std::size_t y = i / width, row_end = std::min(end, (y + 1) * width);
-      run(chunk_in, i, row_end, prior.first + y * prior.row_stride + (i - y * width), partial[c]);
+      run(chunk_in, i, row_end, prior.first + y * prior.row_stride + (i - y * width), partial[c], local, begin);
       i = row_end;
     }
   };
@@ -197,6 +219,20 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& pri
     total.num_cells += p.num_cells;
   }
   if (stats) *stats = total;
+}
+
+}  // namespace
+
+void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& prior, const FusionParams& params,
+                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
+{
+  fuse(map, &scan, nullptr, prior, params, stats, betp, parallel, decisions);
+}
+
+void fusionStep(MapMassGrid& map, const ScanCells& scan, const StepPrior& prior, const FusionParams& params,
+                FusionStepStats* stats, PignisticPlanes* betp, const Parallel* parallel, const StepDecisions* decisions)
+{
+  fuse(map, nullptr, &scan, prior, params, stats, betp, parallel, decisions);
 }
 
 }  // namespace core

@@ -19,13 +19,9 @@ namespace {
 
 /// Largest window side, in cells (a 8192 × 8192 MapGrid already needs 8.6 GB).
 constexpr int kMaxWindowCells = 8192;
-/// Side of the square tiles projectScan() walks the window in, cells.
-constexpr int kProjectTile = 32;
-constexpr std::size_t kClearanceRows = 64;     // rows per chunk of the clearance's passes
 constexpr std::size_t kCellChunk = 16384;      // cells per chunk of the per-cell passes (whole MapGrid blocks)
 static_assert(kCellChunk % MapMassGrid::kBlockCells == 0, "chunks start on a block");
 constexpr std::size_t kPriorRows = 32;         // rows per chunk of the prior window's copy
-constexpr std::size_t kMarkChunk = 32768;       // scan cells or returns per chunk of the occupancy marks
 constexpr std::size_t kSpreadChunk = 256;      // cells per chunk of motion spreading's cell pass
 constexpr std::size_t kSpreadAhead = 4;        // cells ahead whose blocks that pass prefetches
 constexpr std::size_t kFloatsPerLine = 16;     // floats per cache line
@@ -47,12 +43,6 @@ Point2 snappedOrigin(const GridGeometry& g, Point2 p)
 {
   return Point2{ std::round((p.x - 0.5 * g.sizeX()) / g.resolution) * g.resolution,
                  std::round((p.y - 0.5 * g.sizeY()) / g.resolution) * g.resolution };
-}
-
-template <class Frame>
-void copyCell(const MassGrid<Frame>& from, std::size_t i, MassGrid<Frame>& to, std::size_t j)
-{
-  for (int a = 0; a < Frame::kNumSubsets; ++a) to.plane(static_cast<Subset>(a))[j] = from.plane(static_cast<Subset>(a))[i];
 }
 
 /// The 8-connected region of @p start (which @p member must accept) among the cells @p member accepts, depth first,
@@ -124,258 +114,15 @@ std::size_t MapGridParams::bytesPerCell()
 {
   const std::size_t planes = (MapMassGrid::kNumPlanes + 1)  // the stored masses and ζ
                              + FrameMG::kSize              // BetP
-                             + FrameSG::kNumSubsets        // the scan projected into the window
                              + 4                           // the prior window (building, road, other, wall)
                              + 1;                          // the map doubt η
-  return planes * sizeof(float) + sizeof(std::int8_t);     // and the decision
+  constexpr std::size_t kProjectionMasks = 3;              // ScanProjection: occupied, near by row, near
+  return planes * sizeof(float) + sizeof(std::int8_t) + kProjectionMasks;  // and the decision
 }
 
 double MapGridParams::bytesNeeded() const
 {
   return std::round(size_x / resolution) * std::round(size_y / resolution) * static_cast<double>(bytesPerCell());
-}
-
-namespace {
-
-struct ScanPlanes
-{
-  const float* f;
-  const float* o;
-  const float* omega;
-};
-
-/// Window cells [x0, x1) of one row, all inside the scan grid: each takes the scan cell under (fxr + x dfx,
-/// fyr + x dfy) (scan cells); with @p points the occupied mass goes to Ω (point occupancy marks it later).
-MAF_TARGET_CLONES
-void sampleRun(ScanPlanes scan, int scan_width, int scan_height, double fxr, double fyr, double dfx, double dfy, int x0,
-               int x1, bool points, float* __restrict f, float* __restrict o, float* __restrict omega)
-{
-  for (int x = x0; x < x1; ++x)
-  {
-    const double fx = fxr + x * dfx, fy = fyr + x * dfy;
-    // The row interval's test rounds fx and fy without FMA; a clone that contracts them may land one rounding past
-    // the scan grid's last column or row: the index is kept inside.
-    const int ix = std::min(static_cast<int>(fx), scan_width - 1), iy = std::min(static_cast<int>(fy), scan_height - 1);
-    const int i = iy * scan_width + ix;
-    f[x] = scan.f[i];
-    o[x] = points ? 0.0f : scan.o[i];
-    omega[x] = points ? scan.omega[i] + scan.o[i] : scan.omega[i];
-  }
-}
-
-/// The free mass of the cells [0, n) whose @p near is set goes to Ω.
-void clearFree(const std::uint8_t* __restrict near, std::size_t n, float* __restrict f, float* __restrict omega)
-{
-  for (std::size_t x = 0; x < n; ++x)
-  {
-    const bool clear = near[x] != 0;
-    omega[x] = clear ? omega[x] + f[x] : omega[x];
-    f[x] = clear ? 0.0f : f[x];
-  }
-}
-
-/// out[x] |= row[x] for x in [0, n).
-void orRow(const std::uint8_t* __restrict row, std::size_t n, std::uint8_t* __restrict out)
-{
-  for (std::size_t x = 0; x < n; ++x) out[x] |= row[x];
-}
-
-}  // namespace
-
-void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out)
-{
-  projectScan(scan, pose, window, out, nullptr, 0);
-}
-
-void projectScan(const ScanMassGrid& scan, const Pose2& pose, const GridGeometry& window, ScanMassGrid& out,
-                 const ObstaclePoints* obstacles, int clearance_cells, const Parallel* parallel)
-{
-  const Parallel& par = orSerial(parallel);
-  const GridGeometry& had = out.geometry();
-  if (had != window && had.width == window.width && had.height == window.height &&
-      had.resolution == window.resolution && out.stride() > 0)
-  {
-    // The window moved: F, O and Ω are all written below, so only ∅ (which the forward pass may copy) is cleared.
-    out.setOrigin(window.origin_x, window.origin_y);
-    std::fill_n(out.plane(FrameSG::kEmpty), window.numCells(), 0.0f);
-  }
-  else if (had != window)
-  {
-    out.reset(window);
-  }
-  const GridGeometry& sg = scan.geometry();
-  // m(∅) of a ScanGrid is not used by the fusion: only F, O and Ω are mapped (∅ stays 0 in out).
-  float* const df = out.plane(FrameSG::kF);
-  float* const d_o = out.plane(FrameSG::kO);
-  float* const dw = out.plane(FrameSG::kOmega);
-  const float* const sf = scan.plane(FrameSG::kF);
-  const float* const s_o = scan.plane(FrameSG::kO);
-  const float* const sw = scan.plane(FrameSG::kOmega);
-  const bool points = obstacles != nullptr;
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  const double inv_res = 1.0 / sg.resolution;
-  const double dfx = c * window.resolution * inv_res, dfy = -s * window.resolution * inv_res;
-  const int w = window.width, h = window.height;
-  // Inverse mapping: window cell centre → vehicle frame → scan cell. Tiles keep the (rotated) reads local.
-  const Point2 corner = window.cellCentre(CellIndex{ 0, 0 });
-  const double dx0 = corner.x - pose.x, dy0 = corner.y - pose.y;
-  const double fx00 = (c * dx0 + s * dy0 - sg.origin_x) * inv_res, fy00 = (-s * dx0 + c * dy0 - sg.origin_y) * inv_res;
-  const double drx = s * window.resolution * inv_res, dry = c * window.resolution * inv_res;  // per window row
-  const double sw_max = sg.width, sh_max = sg.height;
-  // Each predicate of "inside the scan grid" is monotone along a row (fx, fy are linear in x and rounding is monotone),
-  // so the window cells that sample the scan grid are one interval per row: it is bracketed from the exact bounds
-  // and then trimmed with the very test a per-cell check would use, so the samples are those of a per-cell check.
-  auto inside = [&](double fxr, double fyr, int x) {
-    const double fx = fxr + x * dfx, fy = fyr + x * dfy;
-    return fx >= 0.0 && fy >= 0.0 && fx < sw_max && fy < sh_max;
-  };
-  auto row_interval = [&](double fxr, double fyr, int& x0, int& x1) {
-    double lo = 0.0, hi = w;
-    auto clip = [&](double f0, double df, double max) {  // 0 <= f0 + x df < max
-      if (df == 0.0)
-      {
-        if (!(f0 >= 0.0 && f0 < max)) hi = lo;
-        return;
-      }
-      const double a = (0.0 - f0) / df, b = (max - f0) / df;
-      lo = std::max(lo, std::min(a, b));
-      hi = std::min(hi, std::max(a, b));
-    };
-    clip(fxr, dfx, sw_max);
-    clip(fyr, dfy, sh_max);
-    constexpr int kBracket = 2;
-    x0 = hi <= lo ? 0 : static_cast<int>(std::clamp(std::floor(lo) - kBracket, 0.0, static_cast<double>(w)));
-    x1 = hi <= lo ? 0 : static_cast<int>(std::clamp(std::ceil(hi) + kBracket, 0.0, static_cast<double>(w)));
-    while (x0 < x1 && !inside(fxr, fyr, x0)) ++x0;
-    while (x1 > x0 && !inside(fxr, fyr, x1 - 1)) --x1;
-  };
-  // One band of kProjectTile rows per chunk: each writes its own rows, in tiles that keep the rotated reads local.
-  par.forChunks(chunkCount(static_cast<std::size_t>(h), kProjectTile), [&](std::size_t band) {
-    const int ty = static_cast<int>(band) * kProjectTile;
-    const int ty1 = std::min(h, ty + kProjectTile);
-    int lo[kProjectTile], hi[kProjectTile];
-    double fxr[kProjectTile], fyr[kProjectTile];  // scan cell coordinates of each row's first cell
-    for (int y = ty; y < ty1; ++y)
-    {
-      fxr[y - ty] = fx00 + y * drx;
-      fyr[y - ty] = fy00 + y * dry;
-      row_interval(fxr[y - ty], fyr[y - ty], lo[y - ty], hi[y - ty]);
-      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-      const int l = lo[y - ty], r = hi[y - ty];
-      for (const auto& [b, e] : { std::pair{ 0, l }, std::pair{ r, w } })  // vacuous outside the scan grid
-      {
-        std::fill(df + row + b, df + row + e, 0.0f);
-        std::fill(d_o + row + b, d_o + row + e, 0.0f);
-        std::fill(dw + row + b, dw + row + e, 1.0f);
-      }
-    }
-    for (int tx = 0; tx < w; tx += kProjectTile)
-      for (int y = ty; y < ty1; ++y)
-      {
-        const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-        const int x_end = std::min({ w, tx + kProjectTile, hi[y - ty] });
-        const int x0 = std::max(tx, lo[y - ty]);
-        if (x0 < x_end)
-          sampleRun(ScanPlanes{ sf, s_o, sw }, sg.width, sg.height, fxr[y - ty], fyr[y - ty], dfx, dfy, x0, x_end,
-                    points, df + row, d_o + row, dw + row);
-      }
-  });
-  // Occupancy marks: the occupied cells (or returns) and the window cell under each are found by fixed chunks in
-  // parallel, then applied in index order, so ties resolve as in one serial pass whatever the thread count.
-  struct Mark
-  {
-    std::size_t from, to;  // scan cell or return; window cell
-  };
-  const std::size_t sources = points ? obstacles->count : scan.numCells();
-  const std::size_t mark_chunks = chunkCount(sources, kMarkChunk);
-  thread_local std::vector<std::vector<Mark>> calling_thread_marks;
-  std::vector<std::vector<Mark>>& marks = calling_thread_marks;  // the workers fill the caller's lists
-  if (marks.size() < mark_chunks) marks.resize(mark_chunks);
-  auto window_cell = [&](double vx, double vy, std::size_t& j) {
-    CellIndex wc;
-    if (!window.worldToCell(Point2{ pose.x + c * vx - s * vy, pose.y + s * vx + c * vy }, wc)) return false;
-    j = window.index(wc);
-    return true;
-  };
-  par.forChunks(mark_chunks, [&](std::size_t chunk) {
-    std::vector<Mark>& out_marks = marks[chunk];
-    out_marks.clear();
-    std::size_t j = 0;
-    for (std::size_t k = chunk * kMarkChunk, end = std::min(sources, k + kMarkChunk); k < end; ++k)
-    {
-      if (points)
-      {
-        const double vx = obstacles->xy[2 * k], vy = obstacles->xy[2 * k + 1];
-        CellIndex sc;
-        if (!sg.worldToCell(Point2{ vx, vy }, sc)) continue;
-        const std::size_t i = sg.index(sc);
-        if (s_o[i] > 0.0f && window_cell(vx, vy, j)) out_marks.push_back(Mark{ i, j });
-      }
-      else if (s_o[k] > 0.0f)
-      {
-        const Point2 v = sg.cellCentre(sg.cellOf(k));
-        if (window_cell(v.x, v.y, j)) out_marks.push_back(Mark{ k, j });
-      }
-    }
-  });
-  for (std::size_t chunk = 0; chunk < mark_chunks; ++chunk)
-    for (const Mark& m : marks[chunk])
-    {
-      const float o = s_o[m.from];
-      if (!(o > d_o[m.to])) continue;
-      if (points)
-      {
-        // Point occupancy: the window cell under the return takes its scan cell's occupied mass.
-        df[m.to] = 0.0f;
-        d_o[m.to] = o;
-        dw[m.to] = 1.0f - o;
-      }
-      else
-      {
-        // Forward pass: the window cell under an occupied scan cell's centre takes that cell.
-        copyCell(scan, m.from, out, m.to);
-      }
-    }
-  if (clearance_cells <= 0) return;
-  // Obstacle clearance: no free evidence within clearance_cells (square) of an occupied cell. Separable: a row pass
-  // marks the cells within k columns of an occupied cell (an OR of 2k + 1 shifted rows of bytes), then a column pass
-  // ORs the 2k + 1 marked rows around each row. Both vectorise, are linear in the window whatever the number of
-  // occupied cells, and take bands of rows as independent chunks.
-  thread_local std::vector<std::uint8_t> rows;
-  const std::size_t n = window.numCells();
-  const std::size_t ws = static_cast<std::size_t>(w);
-  if (rows.size() < n) rows.resize(n);
-  std::uint8_t* const near = rows.data();
-  const int k = clearance_cells;
-  par.forRange(static_cast<std::size_t>(h), kClearanceRows, [&](std::size_t y0, std::size_t y1) {
-    thread_local std::vector<std::uint8_t> occupied;
-    occupied.resize(ws);
-    std::uint8_t* const occ = occupied.data();
-    for (std::size_t y = y0; y < y1; ++y)
-    {
-      const float* o = d_o + y * ws;
-      std::uint8_t* r = near + y * ws;
-      for (std::size_t x = 0; x < ws; ++x) occ[x] = o[x] > 0.0f;
-      std::fill(r, r + ws, std::uint8_t{ 0 });
-      for (int d = -k; d <= k; ++d)
-        for (int x = std::max(0, -d), x1 = std::min(w, w - d); x < x1; ++x) r[x] |= occ[x + d];
-    }
-  });
-  // Column pass, row after row: a cell is near an obstacle when the row pass marked it in one of the 2k + 1 rows
-  // around it (an OR of byte rows), so each band of rows streams through the planes in memory order.
-  par.forRange(static_cast<std::size_t>(h), kClearanceRows, [&](std::size_t y0, std::size_t y1) {
-    thread_local std::vector<std::uint8_t> band;
-    band.resize(ws);
-    std::uint8_t* const any = band.data();
-    for (std::size_t y = y0; y < y1; ++y)
-    {
-      std::fill(any, any + ws, std::uint8_t{ 0 });
-      const std::size_t from = y >= static_cast<std::size_t>(k) ? y - static_cast<std::size_t>(k) : 0;
-      const std::size_t to = std::min(static_cast<std::size_t>(h), y + static_cast<std::size_t>(k) + 1);
-      for (std::size_t r = from; r < to; ++r) orRow(near + r * ws, ws, any);
-      clearFree(any, ws, df + y * ws, dw + y * ws);
-    }
-  });
 }
 
 namespace {
@@ -546,10 +293,10 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridP
 
 namespace {
 
-/// spreadMotion(), also giving the cells it changed (the calling thread's buffer, valid until its next call). With
-/// @p found_seeds (the fused step's, StepDecisions::motion_seeds, per chunk in index order) the seeds are not looked
-/// for again.
-std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
+/// spreadMotion() with the scan's occupied cells as @p occupied (non-zero where m(O) > 0), also giving the cells it
+/// changed (the calling thread's buffer, valid until its next call). With @p found_seeds (the fused step's,
+/// StepDecisions::motion_seeds, per chunk in index order) the seeds are not looked for again.
+std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const std::uint8_t* occupied, double share,
                               int max_cells, double threshold, double margin, const Parallel* parallel,
                               const std::vector<std::vector<std::size_t>>* found_seeds,
                               const std::vector<std::size_t>*& changed)
@@ -561,7 +308,6 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const Sc
   if (share <= 0.0) return 0;
   const GridGeometry& g = grid.geometry();
   const std::size_t n = g.numCells();
-  const float* so = scan.plane(FrameSG::kO);
   const float* ps = betp[FrameMG::kSize - 2].data();
   const float* pv = betp[FrameMG::kSize - 1].data();
   const float t = static_cast<float>(threshold);
@@ -587,7 +333,7 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const Sc
     orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
       seeds[c].clear();
       for (std::size_t i = c * kCellChunk, end = std::min(n, i + kCellChunk); i < end; ++i)
-        if (kernels::isMovingSeed(so[i], pv[i], ps[i], t, m)) seeds[c].push_back(i);
+        if (occupied[i] && is_moving(i)) seeds[c].push_back(i);
     });
   }
   const std::vector<std::vector<std::size_t>>& starts = found_seeds ? *found_seeds : seeds;
@@ -602,7 +348,7 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const Sc
     for (const std::size_t start : starts[c])
     {
       if (seen[start]) continue;
-      growRegion(g, start, [so](std::size_t j) { return so[j] > 0.0f; }, seen, stack, region);
+      growRegion(g, start, [occupied](std::size_t j) { return occupied[j] != 0; }, seen, stack, region);
       visited.insert(visited.end(), region.begin(), region.end());
       std::size_t moving = 0;
       for (const std::size_t i : region) moving += is_moving(i);
@@ -649,8 +395,14 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const Sc
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
                          int max_cells, double threshold, double margin, const Parallel* parallel)
 {
+  const std::size_t n = scan.numCells();
+  if (scan.geometry() != grid.geometry()) throw std::invalid_argument("spreadMotion: scan grid and map grid differ");
+  std::vector<std::uint8_t> occupied(n);
+  const float* const so = scan.plane(FrameSG::kO);
+  for (std::size_t i = 0; i < n; ++i) occupied[i] = so[i] > 0.0f;
   const std::vector<std::size_t>* changed = nullptr;
-  return spreadMotionCells(grid, betp, scan, share, max_cells, threshold, margin, parallel, nullptr, changed);
+  return spreadMotionCells(grid, betp, occupied.data(), share, max_cells, threshold, margin, parallel, nullptr,
+                           changed);
 }
 
 std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<std::int8_t>& decision,
@@ -969,8 +721,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
 
   t0 = std::chrono::steady_clock::now();
   const int clearance = static_cast<int>(std::lround(params_.obstacle_clearance / params_.resolution));
-  projectScan(scan, pose, grid_.geometry(), scan_window_, params_.point_occupancy ? obstacles : nullptr, clearance,
-              parallel_.get());
+  projection_.plan(scan, pose, grid_.geometry(), params_.point_occupancy ? obstacles : nullptr, clearance, *parallel_);
   t.project_scan = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -1010,9 +761,9 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   decisions.threshold = params_.decision_threshold;
   decisions.motion_margin = params_.motion_margin;
   if (params_.motion_share > 0.0) decisions.motion_seeds = &motion_seeds_;
-  fusionStep(grid_, scan_window_, step_prior, fp, &stats, &betp_, parallel_.get(), &decisions);
+  fusionStep(grid_, projection_, step_prior, fp, &stats, &betp_, parallel_.get(), &decisions);
   const std::vector<std::size_t>* spread = nullptr;
-  spreadMotionCells(grid_, betp_, scan_window_, params_.motion_share, params_.motion_max_cells,
+  spreadMotionCells(grid_, betp_, projection_.occupied().data(), params_.motion_share, params_.motion_max_cells,
                     params_.decision_threshold, params_.motion_margin, parallel_.get(), &motion_seeds_, spread);
   redecide(grid_, betp_, params_, *spread, decision_);
   t.fusion = secondsSince(t0);

@@ -149,5 +149,32 @@ void fusionStep(MapMassGrid& map, const ScanMassGrid& scan, const StepPrior& pri
 /// Cells per chunk of a parallel fusion step (a multiple of the 8-cell vectors and of the prefetch blocks).
 constexpr std::size_t kFusionChunkCells = 16384;
 
+/**
+ * @brief A scan in the map's cells that is written where it is read: the fused step asks for each chunk's scan
+ *        masses just before it fuses that chunk, so no window of scan masses goes through memory
+ *        (ScanProjection in scan_projection.hpp).
+ */
+class ScanCells
+{
+public:
+  virtual ~ScanCells() = default;
+  /// The cells the scan is given in (the map's).
+  virtual const GridGeometry& geometry() const = 0;
+  /**
+   * @brief m(F), m(O) and m(Ω) of the cells [begin, end) into @p f, @p o, @p omega [0, end − begin). Called from
+   *        several threads at once, on disjoint runs of cells.
+   */
+  virtual void fill(std::size_t begin, std::size_t end, float* f, float* o, float* omega) const = 0;
+};
+
+/**
+ * @brief fusionStep() with the scan of each chunk written by @p scan into a buffer of the thread that fuses it: the
+ *        same masses, ζ, BetP and decisions as fusionStep() on a ScanGrid holding what @p scan fills.
+ * @throws std::invalid_argument as the other overloads.
+ */
+void fusionStep(MapMassGrid& map, const ScanCells& scan, const StepPrior& prior, const FusionParams& params,
+                FusionStepStats* stats = nullptr, PignisticPlanes* betp = nullptr, const Parallel* parallel = nullptr,
+                const StepDecisions* decisions = nullptr);
+
 }  // namespace core
 }  // namespace map_aided_fusion

@@ -106,6 +106,14 @@ struct GridGeometry
   void validate() const;
 };
 
+/// A planar pose: position (metres) and heading (radians, counter-clockwise from +x), REP-103.
+struct Pose2
+{
+  double x = 0.0;
+  double y = 0.0;
+  double yaw = 0.0;
+};
+
 /// A borrowed list of 2D points, interleaved x0, y0, x1, y1, … metres (count points).
 struct ObstaclePoints
 {

@@ -14,17 +14,10 @@
 #include "map_aided_fusion/core/cell_class.hpp"
 #include "map_aided_fusion/core/fusion.hpp"
 #include "map_aided_fusion/core/grid_ops.hpp"
+#include "map_aided_fusion/core/scan_projection.hpp"
 
 namespace map_aided_fusion {
 namespace core {
-
-/// A planar pose: position (metres) and heading (radians, counter-clockwise from +x), REP-103.
-struct Pose2
-{
-  double x = 0.0;
-  double y = 0.0;
-  double yaw = 0.0;
-};
 
 /// Parameters of the MapGrid (config/fusion.yaml).
 struct MapGridParams
@@ -49,8 +42,8 @@ struct MapGridParams
   int min_object_cells = 3;         ///< smaller connected S or V regions are noise (cells, ≥ 1)
   /**
    * Memory the MapGrid's window may take, MiB (in [1, 1048576]). A window whose cells would need more
-   * (bytesPerCell() each: every focal-set plane, ζ, BetP, the projected scan, the prior window and the
-   * decision) is refused by validate(), before anything is allocated.
+   * (bytesPerCell() each: every stored focal-set plane, ζ, BetP, the prior window, the map doubt, the decision and
+   * the projection's occupied and clearance masks) is refused by validate(), before anything is allocated.
    */
   double memory_budget_mb = 2048.0;
 
@@ -155,9 +148,9 @@ void forEachParam(MapGridParams& p, Get&& get)
 struct StageTimes
 {
   double shift = 0.0;
-  double project_scan = 0.0;
+  double project_scan = 0.0;  ///< the projection's plan (ScanProjection::plan); the step samples the scan itself
   double prior_window = 0.0;
-  double fusion = 0.0;
+  double fusion = 0.0;        ///< the fused step (with the scan's samples, BetP, decisions), then motion spreading
 };
 
 /// An object made of a connected region of moving or stopped cells.
@@ -171,28 +164,6 @@ struct GridObject
   int cells = 0;                              ///< number of cells
   double mean_betp = 0.0;                     ///< mean BetP of the object's class over its cells
 };
-
-/**
- * @brief Maps a ScanGrid given in the vehicle frame into the cells of @p window (map frame).
- *
- * Sampling: every window cell takes the scan cell under its centre (nearest neighbour, through the inverse
- * pose), so mass functions are copied, never blended; then every scan cell that carries occupied mass
- * overwrites the window cell under its own centre when it is more occupied. With the same resolution and
- * no rotation this is an exact one-to-one copy; under rotation no occupied scan cell is lost (a thin pole
- * never vanishes between cells). Window cells outside the scan are vacuous.
- */
-void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const GridGeometry& window,
-                 ScanMassGrid& out);
-
-/**
- * @brief projectScan() with the steps "point occupancy" and "obstacle clearance".
- * @param obstacles  when not null: the scan's obstacle returns in the vehicle frame. Occupied scan cells then map to
- *                   Ω, and each return puts its scan cell's occupied mass in the window cell under it (exact).
- * @param clearance_cells  window cells within this many cells (square neighbourhood) of a cell with occupied mass
- *                   lose their free mass to Ω; 0: none.
- */
-void projectScan(const ScanMassGrid& scan, const Pose2& vehicle_in_map, const GridGeometry& window, ScanMassGrid& out,
-                 const ObstaclePoints* obstacles, int clearance_cells, const Parallel* parallel = nullptr);
 
 /**
  * @brief The prior masses of @p window, sampled at each window cell's centre from @p prior (nearest
@@ -333,7 +304,7 @@ public:
 private:
   MapGridParams params_;
   MapMassGrid grid_;
-  ScanMassGrid scan_window_;
+  ScanProjection projection_;  // the scan of the last update in the window's cells, filled chunk by chunk by the step
   PriorWindow prior_window_;  // the prior sampled at the window's cells, when the step cannot read the prior's rows
   AlignedVector<float> map_doubt_;
   PignisticPlanes betp_;
