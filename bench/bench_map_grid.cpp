@@ -1,6 +1,6 @@
 // The full per-scan fusion of the MapGrid: mapping the scan grid into the window, all the paper's steps and
-// the BetP layers, for an N×N window: 800 (160 m at 0.2 m) and the paper's 200 (100 m at 0.5 m); and the scan
-// projection alone.
+// the BetP layers, for an N×N window: 800 (160 m at 0.2 m) and the paper's 200 (100 m at 0.5 m); the bytes it cannot
+// avoid, streamed; and the scan projection alone.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -72,6 +72,73 @@ void BM_MapGridUpdate(benchmark::State& state)
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n) * n);
 }
 
+/// The bytes BM_MapGridUpdate cannot avoid, streamed once with no arithmetic, in the same chunks and threads: read and
+/// write the MapGrid's blocks (29 stored masses and ζ per cell), read the scan's F, O and Ω (its planes at the window's
+/// size, as BM_MapGridUpdate's scan) and the prior's four planes (the window's rows of a prior twice its size), read
+/// and write the map doubt η, write BetP (5 planes) and the decision. What the update adds beyond this is arithmetic
+/// and the passes it makes again (the shift, the projection's plan, motion spreading). Args: N, threads.
+void BM_UpdateBaseline(benchmark::State& state)
+{
+  const int n = static_cast<int>(state.range(0));
+  const double res = n == 200 ? 0.5 : 0.2;
+  const Parallel parallel(static_cast<int>(state.range(1)));
+  const GridGeometry window = GridGeometry::centred(n * res, n * res, res);
+  MapMassGrid map(window);
+  const ScanMassGrid scan = benchScan(n, res);
+  PriorWindow prior(GridGeometry::centred(2.0 * n * res, 2.0 * n * res, res));
+  AlignedVector<float> eta(window.numCells(), 0.0f);
+  PignisticPlanes betp;
+  for (auto& p : betp.p) p.assign(window.numCells(), 0.0f);
+  std::vector<std::int8_t> decision(window.numCells());
+  const std::size_t cells = window.numCells(), w = static_cast<std::size_t>(n);
+  const std::size_t prior_w = static_cast<std::size_t>(prior.geometry.width);
+  const std::size_t prior_first = (prior_w / 4) * prior_w + prior_w / 4;  // the window's cell (0, 0)
+  constexpr std::size_t kBlock = MapMassGrid::kBlockCells;
+  constexpr int kSlots = MapMassGrid::kNumPlanes + 1;
+  const float* const in_scan[3] = { scan.plane(FrameSG::kF), scan.plane(FrameSG::kO), scan.plane(FrameSG::kOmega) };
+  const float* const in_prior[4] = { prior.building.data(), prior.road.data(), prior.other.data(), prior.wall.data() };
+  float* const out_betp[FrameMG::kSize] = { betp.p[0].data(), betp.p[1].data(), betp.p[2].data(), betp.p[3].data(),
+                                            betp.p[4].data() };
+  float* const eta_data = eta.data();
+  std::int8_t* const decision_data = decision.data();
+  for (auto _ : state)
+  {
+    float* const base = map.planes();
+    parallel.forRange(cells, kFusionChunkCells, [&](std::size_t c0, std::size_t c1) {
+      float add[kFusionChunkCells];  // per cell of the chunk: what it read
+      const std::size_t len = c1 - c0;
+      std::fill_n(add, len, 0.0f);
+      for (const float* p : in_scan)
+        for (std::size_t k = 0; k < len; ++k) add[k] += p[c0 + k];
+      for (std::size_t i = c0; i < c1;)  // the prior's rows
+      {
+        const std::size_t row_end = std::min(c1, (i / w + 1) * w);
+        const std::size_t at = prior_first + i / w * prior_w + i % w;
+        for (const float* p : in_prior)
+          for (std::size_t k = 0; k < row_end - i; ++k) add[i - c0 + k] += p[at + k];
+        i = row_end;
+      }
+      float* __restrict const e = eta_data + c0;
+      for (std::size_t k = 0; k < len; ++k) e[k] = e[k] * 0.5f + add[k];
+      for (std::size_t i0 = c0; i0 < c1; i0 += kBlock)
+      {
+        float* __restrict const block = base + MapMassGrid::blockOffset(i0);
+        for (int a = 0; a < kSlots; ++a)
+          for (std::size_t k = 0; k < kBlock; ++k) block[a * kBlock + k] = block[a * kBlock + k] * 0.5f + add[i0 - c0 + k];
+      }
+      for (float* p : out_betp)
+      {
+        float* __restrict const q = p + c0;
+        for (std::size_t k = 0; k < len; ++k) q[k] = add[k];
+      }
+      std::int8_t* __restrict const d = decision_data + c0;
+      for (std::size_t k = 0; k < len; ++k) d[k] = static_cast<std::int8_t>(add[k] > 1.0f);
+    });
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n) * n);
+}
+
 /// projectScan() alone on an 800 × 800 window at 0.2 m, the scan rotated by 0.1 rad: the resampling and, with Arg
 /// clearance > 0, the step "obstacle clearance" over that many cells. Args: clearance cells, threads.
 void BM_ProjectScan(benchmark::State& state)
@@ -94,6 +161,8 @@ void BM_ProjectScan(benchmark::State& state)
 }  // namespace
 
 BENCHMARK(BM_MapGridUpdate)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_UpdateBaseline)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ProjectScan)->ArgsProduct({ { 0, 5 }, { 1, 2 } })->ArgNames({ "clearance", "threads" })->UseRealTime()
     ->Unit(benchmark::kMillisecond);
