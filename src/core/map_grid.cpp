@@ -117,7 +117,7 @@ std::size_t MapGridParams::bytesPerCell()
                              + 4                           // the prior window (building, road, other, wall)
                              + 1;                          // the map doubt η
   constexpr std::size_t kProjectionMasks = 3;              // ScanProjection: occupied, near by row, near
-  return planes * sizeof(float) + sizeof(std::int8_t) + kProjectionMasks;  // and the decision
+  return planes * sizeof(float) + sizeof(std::int8_t) /* the decision */ + kProjectionMasks;
 }
 
 double MapGridParams::bytesNeeded() const
@@ -333,7 +333,7 @@ std::size_t spreadMotionCells(MapMassGrid& grid, PignisticPlanes& betp, const st
     orSerial(parallel).forChunks(chunks, [&](std::size_t c) {
       seeds[c].clear();
       for (std::size_t i = c * kCellChunk, end = std::min(n, i + kCellChunk); i < end; ++i)
-        if (occupied[i] && is_moving(i)) seeds[c].push_back(i);
+        if (kernels::isMovingSeed(static_cast<float>(occupied[i]), pv[i], ps[i], t, m)) seeds[c].push_back(i);
     });
   }
   const std::vector<std::vector<std::size_t>>& starts = found_seeds ? *found_seeds : seeds;

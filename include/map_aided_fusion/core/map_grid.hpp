@@ -224,6 +224,7 @@ void decide(const MapMassGrid& grid, const PignisticPlanes& betp, double thresho
  *        BetP(V) ≥ @p threshold and BetP(V) − BetP(S) > @p margin (an open {S, V} is not motion). Returns the number
  *        of regions spread. @p parallel: the threads that look for the moving cells (the result is the same for any
  *        number).
+ * @throws std::invalid_argument when @p scan and @p grid have different geometries.
  */
 std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMassGrid& scan, double share,
                          int max_cells, double threshold, double margin, const Parallel* parallel = nullptr);
