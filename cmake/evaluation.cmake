@@ -1,5 +1,6 @@
 # Evaluation: ROS-free metrics library, the `evaluate` tool (reads bags) and its tests.
-add_library(map_aided_fusion_eval src/eval/metrics.cpp src/eval/point_labels.cpp)
+add_library(map_aided_fusion_eval src/eval/metrics.cpp src/eval/point_labels.cpp src/eval/movers.cpp
+  src/eval/clear_mot.cpp)
 target_link_libraries(map_aided_fusion_eval map_aided_fusion_core)
 target_include_directories(map_aided_fusion_eval PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 
@@ -8,7 +9,8 @@ install(TARGETS map_aided_fusion_eval
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
-  catkin_add_gtest(test_metrics test/eval/test_metrics.cpp test/test_main.cpp)
+  catkin_add_gtest(test_metrics test/eval/test_metrics.cpp test/eval/test_movers.cpp test/eval/test_clear_mot.cpp
+    test/test_main.cpp)
   target_link_libraries(test_metrics map_aided_fusion_eval)
 endif()
 

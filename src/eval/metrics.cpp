@@ -36,6 +36,8 @@ std::string escape(const std::string& s)
   return out;
 }
 
+void metaJson(std::ostringstream& out, const std::map<std::string, std::string>& meta);
+
 }  // namespace
 
 std::int8_t ClassGrid::at(core::Point2 p) const
@@ -131,12 +133,12 @@ std::uint64_t accumulate(const ClassGrid& truth, const ClassGrid& decision, Conf
   return compared;
 }
 
-bool TruthObject::contains(core::Point2 p) const
+bool TruthObject::contains(core::Point2 p, double margin) const
 {
   const double dx = p.x - centre.x, dy = p.y - centre.y;
   const double c = std::cos(yaw), s = std::sin(yaw);
   const double u = c * dx + s * dy, v = -s * dx + c * dy;
-  return std::abs(u) <= 0.5 * length && std::abs(v) <= 0.5 * width;
+  return std::abs(u) <= 0.5 * length + margin && std::abs(v) <= 0.5 * width + margin;
 }
 
 ObjectScorer::ObjectScorer(int min_visible_cells, double detection_window, double hidden_window)
@@ -257,20 +259,15 @@ std::map<std::string, double> flatten(const VariantScores& v)
   m["moving.trail_cells_per_scan"] = v.objects.trailCellsPerScan();
   m["moving.trail_fraction_of_free"] = v.objects.trailFraction();
   m["scans"] = static_cast<double>(v.scans);
+  if (!v.movers.stamps().empty())
+    for (const auto& [k, x] : v.movers.summary()) m[k] = x;
   return m;
 }
 
 std::string toJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta)
 {
   std::ostringstream out;
-  out << "{\n  \"meta\": {";
-  bool first = true;
-  for (const auto& [k, v] : meta)
-  {
-    out << (first ? "\n" : ",\n") << "    \"" << escape(k) << "\": \"" << escape(v) << "\"";
-    first = false;
-  }
-  out << "\n  },\n  \"variants\": {";
+  metaJson(out, meta);
   for (std::size_t i = 0; i < variants.size(); ++i)
   {
     const auto& v = variants[i];
@@ -285,7 +282,41 @@ std::string toJson(const std::vector<VariantScores>& variants, const std::map<st
       for (int d = 0; d <= kNumCellClasses; ++d) out << (d ? ", " : "") << v.confusion.count(t, d);
       out << "]";
     }
-    out << "]}\n    }";
+    out << "]}";
+    if (!v.movers.stamps().empty()) out << ",\n      \"movers_objects\": " << moverObjectsJson(v.movers);
+    out << "\n    }";
+  }
+  out << "\n  }\n}\n";
+  return out.str();
+}
+
+namespace {
+
+void metaJson(std::ostringstream& out, const std::map<std::string, std::string>& meta)
+{
+  out << "{\n  \"meta\": {";
+  bool first = true;
+  for (const auto& [k, v] : meta)
+  {
+    out << (first ? "\n" : ",\n") << "    \"" << escape(k) << "\": \"" << escape(v) << "\"";
+    first = false;
+  }
+  out << "\n  },\n  \"variants\": {";
+}
+
+}  // namespace
+
+std::string moversJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta)
+{
+  std::ostringstream out;
+  metaJson(out, meta);
+  for (std::size_t i = 0; i < variants.size(); ++i)
+  {
+    const auto& v = variants[i];
+    out << (i ? ",\n" : "\n") << "    \"" << escape(v.name) << "\": {\n      \"description\": \"" << escape(v.description)
+        << "\",\n      \"scans\": " << v.scans;
+    for (const auto& [k, x] : v.movers.summary()) out << ",\n      \"" << k << "\": " << number(x);
+    out << ",\n      \"movers_objects\": " << moverObjectsJson(v.movers) << "\n    }";
   }
   out << "\n  }\n}\n";
   return out.str();

@@ -1,12 +1,19 @@
 #include "map_aided_fusion/ros/kitti_bag.hpp"
 
+#include <cctype>
 #include <cstdio>
+#include <optional>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
+#include <cmath>
+#include <map>
+#include <set>
+
 #include <geometry_msgs/TransformStamped.h>
 #include <rosbag/bag.h>
+#include "map_aided_fusion/GroundTruthObjectArray.h"
 #include <tf2_msgs/TFMessage.h>
 
 #include "map_aided_fusion/ros/bag_writing.hpp"
@@ -19,6 +26,16 @@ constexpr std::uint32_t kPointStep = 16;         // x y z intensity, float32
 constexpr std::uint32_t kLabelledPointStep = 17;  // x y z float32, label uint32, state uint8
 constexpr std::uint32_t kLabelOffset = 12;
 constexpr std::uint32_t kStateOffset = 16;
+constexpr std::int8_t kValidCode = 100;
+constexpr std::int8_t kMovingCode = 4;     // core::CellClass::kMoving
+constexpr std::int8_t kParkedCode = 3;     // core::CellClass::kStopped
+constexpr std::int8_t kAmbiguousCode = -1;  // core::CellClass::kUnknown: motion not judged
+
+std::string lowerCase(std::string s)
+{
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
 
 geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& t, const ros::Time& stamp,
                                             const std::string& parent, const std::string& child)
@@ -112,6 +129,46 @@ std::vector<LabelledCloudPoint> KittiConversions::fromLabelledCloud(const sensor
   return out;
 }
 
+GroundTruthObject KittiConversions::toGroundTruthObject(const dataset::TrackedBox& b)
+{
+  GroundTruthObject m;
+  m.id = static_cast<std::uint32_t>(b.track_id);
+  m.cell_class = b.motion == dataset::BoxMotion::kMoving   ? kMovingCode
+                 : b.motion == dataset::BoxMotion::kParked ? kParkedCode
+                                                           : kAmbiguousCode;
+  m.kind = lowerCase(b.type);
+  m.pose.position.x = b.centre.x();
+  m.pose.position.y = b.centre.y();
+  m.pose.position.z = b.centre.z();
+  m.pose.orientation.w = std::cos(0.5 * b.yaw);
+  m.pose.orientation.z = std::sin(0.5 * b.yaw);
+  m.size.x = b.length;
+  m.size.y = b.width;
+  m.size.z = b.height;
+  m.velocity.x = b.velocity.x();
+  m.velocity.y = b.velocity.y();
+  return m;
+}
+
+void KittiConversions::toValidGrid(const std::vector<std::int8_t>& mask, double resolution, int width, int height,
+                                   double origin_x, double origin_y, const ros::Time& stamp,
+                                   const std::string& frame_id, nav_msgs::OccupancyGrid& msg)
+{
+  if (mask.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+    throw std::invalid_argument("toValidGrid: the mask does not hold width x height cells");
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame_id;
+  msg.info.map_load_time = stamp;
+  msg.info.resolution = static_cast<float>(resolution);
+  msg.info.width = static_cast<std::uint32_t>(width);
+  msg.info.height = static_cast<std::uint32_t>(height);
+  msg.info.origin.position.x = origin_x;
+  msg.info.origin.position.y = origin_y;
+  msg.info.origin.orientation.w = 1.0;
+  msg.data.resize(mask.size());
+  for (std::size_t i = 0; i < mask.size(); ++i) msg.data[i] = mask[i] ? kValidCode : 0;
+}
+
 Eigen::Isometry3d KittiConversions::toIsometry(const geometry_msgs::TransformStamped& t)
 {
   Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
@@ -161,6 +218,11 @@ KittiBagStats writeKittiBag(const dataset::KittiSequence& sequence, const KittiB
     statics.transforms.push_back(toTransform(lift, first, o.base_frame, o.lidar_frame));
     bag.write("/tf_static", first, statics, latchedConnectionHeader<tf2_msgs::TFMessage>("/kitti_to_bag"));
     const Eigen::Isometry3d lift_inv = lift.inverse();
+    std::optional<dataset::KittiTracking> tracking;
+    if (dataset::KittiTracking::present(sequence.folder()))
+      tracking.emplace(sequence, o.lidar_height, o.motion, o.strict_labels);
+    std::map<int, std::set<dataset::BoxMotion>> track_motions;
+    const int valid_cells = static_cast<int>(std::lround(o.valid_size / o.valid_resolution));
     for (std::size_t k = 0; k < sequence.size(); ++k)
     {
       ros::Time stamp;
@@ -181,9 +243,34 @@ KittiBagStats writeKittiBag(const dataset::KittiSequence& sequence, const KittiB
         ++stats.labelled_scans;
         for (std::uint32_t l : labels) stats.moving_points += dataset::stateOf(l) == dataset::PointState::kMoving;
       }
+      if (tracking)
+      {
+        GroundTruthObjectArray objects;
+        objects.header.stamp = stamp;
+        objects.header.frame_id = o.map_frame;
+        for (const dataset::TrackedBox& b : tracking->boxes(k))
+        {
+          objects.objects.push_back(KittiConversions::toGroundTruthObject(b));
+          track_motions[b.track_id].insert(b.motion);
+        }
+        stats.object_boxes += objects.objects.size();
+        bag.write(o.objects_topic, stamp, objects);
+        const Eigen::Vector3d lidar = (lift * sequence.lidarPose(k)).translation();
+        const double ox = std::floor((lidar.x() - 0.5 * o.valid_size) / o.valid_resolution) * o.valid_resolution;
+        const double oy = std::floor((lidar.y() - 0.5 * o.valid_size) / o.valid_resolution) * o.valid_resolution;
+        nav_msgs::OccupancyGrid valid;
+        KittiConversions::toValidGrid(tracking->validMask(k, o.valid_resolution, valid_cells, valid_cells, ox, oy),
+                                      o.valid_resolution, valid_cells, valid_cells, ox, oy, stamp, o.map_frame, valid);
+        bag.write(o.valid_topic, stamp, valid);
+      }
       ++stats.scans;
       stats.points += points.size();
       if (o.progress) o.progress(k + 1, sequence.size());
+    }
+    for (const auto& [id, motions] : track_motions)
+    {
+      stats.moving_tracks += motions.count(dataset::BoxMotion::kMoving) > 0;
+      stats.parked_tracks += motions.count(dataset::BoxMotion::kParked) > 0 && !motions.count(dataset::BoxMotion::kMoving);
     }
     bag.close();
   }

@@ -35,6 +35,7 @@
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/eval/metrics.hpp"
+#include "map_aided_fusion/eval/movers.hpp"
 #include "map_aided_fusion/eval/point_labels.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
@@ -91,7 +92,9 @@ void usage()
                "  A simulator bag (/ground_truth/classes, /ground_truth/objects) is scored per cell and per object;\n"
                "  a labelled real bag (/ground_truth/points, from kitti_to_bag) per labelled point: false V (V cells\n"
                "  farther than --match-radius, 1 m, from every moving point), moving objects' cells decided V,\n"
-               "  decisions of static obstacle cells. Without --map (or a map_file in the prior config) the\n"
+               "  decisions of static obstacle cells; a bag of labelled boxes (/ground_truth/objects without\n"
+               "  /ground_truth/classes: KITTI tracking, from kitti_to_bag) per object: first seen, first V, delay,\n"
+               "  V and S shares, false V where /ground_truth/valid says the labels are valid. Without --map (or a map_file in the prior config) the\n"
                "  pipeline runs without prior. --only runs just the named variants (e.g. `default`, as the tuner does).\n"
                "  --check-config loads and validates the three files and exits: 0, or 1 with the parameter's name.\n";
 }
@@ -345,6 +348,28 @@ std::vector<eval::LabelledPoint> toLabelledPoints(const sensor_msgs::PointCloud2
       sg.ground_height + sg.obstacle_min_height, sg.ground_height + sg.obstacle_max_height);
 }
 
+/// The movers tables of metrics.md: per kind for the main variants, all kinds for the ablations, per object.
+std::string moversSection(const std::vector<eval::VariantScores>& scores, bool objects_only)
+{
+  std::vector<std::pair<std::string, const eval::MoverScorer*>> main_rows, all_rows;
+  for (const auto& v : scores)
+  {
+    if (v.movers.stamps().empty()) continue;
+    all_rows.emplace_back(v.name, &v.movers);
+    if (v.name == "default" || v.name == "paper" || v.name == "live") main_rows.emplace_back(v.name, &v.movers);
+  }
+  if (all_rows.empty()) return "";
+  std::ostringstream out;
+  out << (objects_only ? "" : "## Moving objects\n\n")
+      << "Movers per kind (README, \"Scoring moving objects\": seen, V, S and false V defined there):\n\n"
+      << eval::moversMarkdown(main_rows, true);
+  if (all_rows.size() > main_rows.size())
+    out << "\nEvery variant, all kinds:\n\n" << eval::moversMarkdown(all_rows, false);
+  for (const auto& [name, scorer] : main_rows)
+    out << "\nPer mover, `" << name << "`:\n\n" << eval::moverObjectsMarkdown(*scorer);
+  return out.str();
+}
+
 void writeSnapshotNpy(const fs::path& dir, const std::string& stem, const eval::ClassGrid& g)
 {
   writeNpy(dir / (stem + "_decision.npy"), g.cells.data(),
@@ -399,6 +424,7 @@ int main(int argc, char** argv)
     tf2::BufferCore tf(ros::Duration(1e6));
     std::map<std::int64_t, eval::ClassGrid> truth;
     std::map<std::int64_t, std::vector<eval::TruthObject>> truth_objects;
+    std::map<std::int64_t, eval::ClassGrid> valid_masks;
     std::set<std::int64_t> labelled_stamps;
     std::size_t clouds = 0;
     {
@@ -419,6 +445,10 @@ int main(int argc, char** argv)
         {
           if (auto msg = m.instantiate<GroundTruthObjectArray>())
             truth_objects[key(msg->header.stamp)] = toTruthObjects(*msg);
+        }
+        else if (topic == "/ground_truth/valid")
+        {
+          if (auto msg = m.instantiate<nav_msgs::OccupancyGrid>()) valid_masks[key(msg->header.stamp)] = toClassGrid(*msg);
         }
         else if (topic == "/ground_truth/points")
         {
@@ -453,10 +483,34 @@ int main(int argc, char** argv)
       }
     }
     if (clouds == 0) throw std::runtime_error(opt.bag + " has no /points");
-    const bool point_mode = truth.empty();
+    // Ground truth: simulator cells, labelled points (SemanticKITTI) or labelled boxes (KITTI tracking).
+    const bool object_mode = truth.empty() && !truth_objects.empty();
+    const bool point_mode = truth.empty() && !object_mode;
     if (point_mode && labelled_stamps.empty())
-      throw std::runtime_error(opt.bag + " has neither /ground_truth/classes (simulator) nor /ground_truth/points "
-                                         "(labelled real data, kitti_to_bag)");
+      throw std::runtime_error(opt.bag + " has neither /ground_truth/classes (simulator), /ground_truth/points "
+                                         "(labelled real points, kitti_to_bag) nor /ground_truth/objects (labelled "
+                                         "boxes, kitti_to_bag on KITTI tracking)");
+    const eval::ReturnsInBoxes in_boxes{ configured.scan_grid.ground_height + configured.scan_grid.obstacle_min_height,
+                                         configured.scan_grid.ground_height + configured.scan_grid.obstacle_max_height };
+    // Labelled boxes: each sweep's obstacle returns in each box (map frame), for the offline and the live scores.
+    std::map<std::int64_t, std::vector<eval::ObjectReturns>> object_returns;
+    auto scoreMovers = [&](eval::MoverScorer& movers, double t, const ros::Time& stamp, const eval::ClassGrid& decision,
+                           const std::vector<eval::TruthObject>* objects, const eval::ClassGrid* gt) {
+      const std::vector<eval::TruthObject> none;
+      const auto& objs = objects ? *objects : none;
+      if (object_mode)
+      {
+        const auto r = object_returns.find(key(stamp));
+        const eval::ClassGrid* valid = nearest(valid_masks, stamp);
+        eval::ClassGrid nothing_valid;
+        movers.add(t, r == object_returns.end() ? std::vector<eval::ObjectSighting>{}
+                                                : eval::sightingsFromReturns(r->second, decision),
+                   eval::countFalseV(decision, valid ? valid : &nothing_valid, objs, opt.match_radius));
+      }
+      else if (gt)
+        movers.add(t, eval::sightingsFromClassGrid(*gt, objs, decision),
+                   eval::countFalseV(decision, nullptr, objs, opt.match_radius));
+    };
 
     std::vector<std::unique_ptr<Variant>> variants;
     std::vector<std::pair<core::PriorGridOptions, std::shared_ptr<const core::PriorWindow>>> priors;
@@ -526,6 +580,8 @@ int main(int argc, char** argv)
     std::ofstream csv(fs::path(opt.out) / "scores.csv");
     if (point_mode)
       csv << "time_s,variant,labelled,v_cells,false_v,v_on_static,mover_cells,mover_v_cells\n";
+    else if (object_mode)
+      csv << "time_s,variant,labelled_objects,movers_seen,movers_v\n";
     else
     {
       csv << "time_s,variant,scan_compared_cells";
@@ -607,9 +663,14 @@ int main(int argc, char** argv)
       if (!t0) t0 = t;
       const core::Pose2 pose{ base.transform.translation.x, base.transform.translation.y,
                               tf2::getYaw(base.transform.rotation) };
-      const eval::ClassGrid* gt = point_mode ? nullptr : nearest(truth, cloud->header.stamp);
+      const eval::ClassGrid* gt = point_mode || object_mode ? nullptr : nearest(truth, cloud->header.stamp);
       const auto* objects = point_mode ? nullptr : nearest(truth_objects, cloud->header.stamp);
-      if (!gt && !point_mode) ++no_truth;
+      if (!gt && !point_mode && !object_mode) ++no_truth;
+      if (object_mode && !objects) ++no_truth;
+      if (object_mode && objects)
+        object_returns[key(cloud->header.stamp)] = eval::collectObjectReturns(
+            pv, KittiConversions::toIsometry(base) * KittiConversions::toIsometry(sensor),
+            KittiConversions::toIsometry(sensor), *objects, in_boxes);
       const bool snapshot = snapshot_at < 0.0 && t - *t0 >= snapshot_time;
       const bool sheet = t - *t0 >= next_sheet;
       const std::int64_t k = key(cloud->header.stamp);
@@ -644,11 +705,27 @@ int main(int argc, char** argv)
           ++v->scores.scans;
           continue;
         }
+        if (object_mode)
+        {
+          scoreMovers(v->scores.movers, t, cloud->header.stamp, v->decision, objects, nullptr);
+          int seen = 0, as_v = 0;
+          for (const auto& [id, r] : v->scores.movers.records())
+            if (!r.timeline.empty() && r.timeline.back().first + 1 == v->scores.movers.stamps().size())
+            {
+              seen += r.timeline.back().second != eval::SightingState::kUnseen;
+              as_v += r.timeline.back().second == eval::SightingState::kV;
+            }
+          csv << (t - *t0) << "," << v->scores.name << "," << (objects ? objects->size() : 0) << "," << seen << ","
+              << as_v << "\n";
+          ++v->scores.scans;
+          continue;
+        }
         if (!gt) continue;
         eval::ConfusionMatrix scan_confusion;
         const auto compared = eval::accumulate(*gt, v->decision, scan_confusion);
         v->scores.confusion.add(scan_confusion);
         v->scores.objects.add(t, *gt, objects ? *objects : std::vector<eval::TruthObject>{}, v->decision);
+        scoreMovers(v->scores.movers, t, cloud->header.stamp, v->decision, objects, gt);
         ++v->scores.scans;
         csv << (t - *t0) << "," << v->scores.name << "," << compared;
         for (int c = 0; c < core::kNumCellClasses; ++c)
@@ -656,6 +733,7 @@ int main(int argc, char** argv)
         csv << "," << scan_confusion.accuracy() << "\n";
       }
       if (labelled) scorePending(k);
+      if (object_mode) continue;
       if (point_mode)
       {
         // Snapshots of every sweep's decisions for the figures (small runs; long sequences: every sheet period).
@@ -780,11 +858,19 @@ int main(int argc, char** argv)
           ++s.scans;
           continue;
         }
+        if (object_mode)
+        {
+          scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision,
+                      nearest(truth_objects, d->header.stamp), nullptr);
+          ++s.scans;
+          continue;
+        }
         const eval::ClassGrid* gt = nearest(truth, d->header.stamp);
         if (!gt) continue;
         eval::accumulate(*gt, decision, s.confusion);
         const auto* objects = nearest(truth_objects, d->header.stamp);
         s.objects.add(d->header.stamp.toSec(), *gt, objects ? *objects : std::vector<eval::TruthObject>{}, decision);
+        scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision, objects, gt);
         ++s.scans;
       }
       if (s.scans == 0) std::cerr << "evaluate: no decision of " << opt.output_bag << " matches the bag's stamps\n";
@@ -793,7 +879,9 @@ int main(int argc, char** argv)
     bag.close();
 
     std::map<std::string, std::string> meta{ { "bag", opt.bag },
-                                             { "ground_truth", point_mode ? "labelled points" : "simulator cells" },
+                                             { "ground_truth", point_mode    ? "labelled points"
+                                                               : object_mode ? "labelled boxes"
+                                                                             : "simulator cells" },
                                              { "prior", prior_summary },
                                              { "pose_covariances", std::to_string(covariance_sigma.size()) + " on '" +
                                                                        covariance_topic + "', " +
@@ -839,14 +927,23 @@ int main(int argc, char** argv)
       }
       json << "\n  }\n}\n";
     }
+    else if (object_mode)
+    {
+      meta["valid_masks"] = std::to_string(valid_masks.size());
+      std::ofstream(fs::path(opt.out) / "metrics.json") << eval::moversJson(scores, meta);
+      markdown = moversSection(scores, true);
+    }
     else
     {
       std::ofstream(fs::path(opt.out) / "metrics.json") << eval::toJson(scores, meta);
-      markdown = eval::toMarkdown(scores);
+      markdown = eval::toMarkdown(scores) + "\n" + moversSection(scores, false);
     }
     std::ofstream(fs::path(opt.out) / "metrics.md") << "# map_aided_fusion evaluation\n\nBag: `" << opt.bag << "`, "
                                                      << done << " scans"
-                                                     << (point_mode ? " (labelled real data)" : "") << ".\n\n"
+                                                     << (point_mode    ? " (labelled real data)"
+                                                         : object_mode ? " (labelled real objects)"
+                                                                       : "")
+                                                     << ".\n\n"
                                                      << markdown;
     std::cout << markdown;
     std::cout << "wrote " << (fs::path(opt.out) / "metrics.json").string() << ", metrics.md, scores.csv, snapshots/\n";

@@ -1,5 +1,8 @@
-// kitti_to_bag: a KITTI odometry / SemanticKITTI sequence folder → a bag with /points, /tf, /tf_static and the
-// per-point ground truth (/ground_truth/points), for the live nodelets (rosbag play --clock) and evaluate.
+// kitti_to_bag: a KITTI odometry / SemanticKITTI / KITTI tracking sequence folder → a bag with /points, /tf,
+// /tf_static and the ground truth (/ground_truth/points per point; /ground_truth/objects and /ground_truth/valid
+// per tracking sweep), for the live nodelets (rosbag play --clock) and evaluate.
+#include <unistd.h>
+
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -15,7 +18,9 @@ void usage()
   std::cerr << "usage: kitti_to_bag --sequence DIR --out BAG [--frames N] [--start-stamp S] [--lidar-height M]\n"
                "                    [--quiet]\n"
                "  DIR is one KITTI odometry / SemanticKITTI sequence: velodyne/*.bin, labels/*.label (optional,\n"
-               "  per frame), poses.txt, calib.txt (Tr), times.txt. Writes BAG.partial and renames it to BAG when\n"
+               "  per frame), poses.txt, calib.txt (Tr), times.txt; or a KITTI tracking sequence in that layout with\n"
+               "  label_02.txt and a P2 line in calib.txt (boxes with track ids: ground-truth objects with velocity\n"
+               "  and motion state, and where the labels are valid). Writes BAG.partial and renames it to BAG when\n"
                "  every frame is written. --frames: the first N frames only. --start-stamp: ROS time of the\n"
                "  sequence's time 0 (default 1317376800). --lidar-height: the velodyne above the ground (1.73 m).\n";
 }
@@ -59,6 +64,7 @@ int main(int argc, char** argv)
         if (!(n >= 1.0 && n <= 1e9) || n != static_cast<double>(static_cast<std::size_t>(n)))
           throw std::runtime_error("--frames must be a whole number >= 1");
         frames = static_cast<std::size_t>(n);
+        options.strict_labels = false;
       }
       else if (a == "--start-stamp") options.start_stamp = number(a, value());
       else if (a == "--lidar-height") options.lidar_height = number(a, value());
@@ -86,14 +92,18 @@ int main(int argc, char** argv)
   try
   {
     const dataset::KittiSequence sequence(folder, frames);
-    if (!quiet)
+    if (!quiet && ::isatty(STDERR_FILENO))
       options.progress = [](std::size_t done, std::size_t total) {
         std::fprintf(stderr, "\rkitti_to_bag: %zu/%zu frames", done, total);
         if (done == total) std::fprintf(stderr, "\n");
       };
     const KittiBagStats s = writeKittiBag(sequence, options);
     std::cout << "wrote " << options.path << ": " << s.scans << " scans (" << s.labelled_scans << " labelled), "
-              << s.points << " points, " << s.moving_points << " moving points\n";
+              << s.points << " points, " << s.moving_points << " moving points";
+    if (s.object_boxes)
+      std::cout << ", " << s.object_boxes << " tracking boxes (" << s.moving_tracks << " moving tracks, "
+                << s.parked_tracks << " parked)";
+    std::cout << "\n";
     return 0;
   }
   catch (const std::exception& e)

@@ -13,44 +13,18 @@
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "kitti_folder.hpp"
 #include "map_aided_fusion/ros/kitti_bag.hpp"
 
 namespace fs = std::filesystem;
 using namespace map_aided_fusion;
 using dataset::KittiError;
 using dataset::KittiSequence;
+using maf_test::Folder;
 
 namespace {
 
 constexpr const char* kTr = "Tr: 0 -1 0 0.1 0 0 -1 -0.2 1 0 0 -0.3\n";  // velodyne x → camera z, y → −x, z → −y
-
-struct Folder
-{
-  fs::path dir;
-  explicit Folder(const std::string& name) : dir(fs::temp_directory_path() / ("maf_kitti_" + name + "_" +
-                                                                              std::to_string(::getpid())))
-  {
-    fs::remove_all(dir);
-    fs::create_directories(dir / "velodyne");
-    fs::create_directories(dir / "labels");
-  }
-  ~Folder() { fs::remove_all(dir); }
-  void text(const std::string& name, const std::string& content) const { std::ofstream(dir / name) << content; }
-  void scan(int frame, const std::vector<dataset::KittiPoint>& pts) const
-  {
-    char n[32];
-    std::snprintf(n, sizeof n, "velodyne/%06d.bin", frame);
-    std::ofstream f(dir / n, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(pts.data()), static_cast<std::streamsize>(pts.size() * sizeof pts[0]));
-  }
-  void labels(int frame, const std::vector<std::uint32_t>& l) const
-  {
-    char n[32];
-    std::snprintf(n, sizeof n, "labels/%06d.label", frame);
-    std::ofstream f(dir / n, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(l.data()), static_cast<std::streamsize>(l.size() * sizeof l[0]));
-  }
-};
 
 /// Three frames of 4 points; camera 0 moves 1 m along its z axis (the lidar's x) per frame; frames 0 and 1 labelled.
 void writeSequence(const Folder& f)

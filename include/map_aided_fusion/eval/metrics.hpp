@@ -13,20 +13,11 @@
 
 #include "map_aided_fusion/core/cell_class.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
+#include "map_aided_fusion/eval/movers.hpp"
+#include "map_aided_fusion/eval/truth.hpp"
 
 namespace map_aided_fusion {
 namespace eval {
-
-using core::kNumCellClasses;
-
-/// A class grid (ground truth or decision) in the map frame: core::CellClass codes per cell.
-struct ClassGrid
-{
-  core::GridGeometry geometry;
-  std::vector<std::int8_t> cells;
-  /// The code at a world point, kUnknown outside.
-  std::int8_t at(core::Point2 p) const;
-};
 
 /// Confusion counts: rows = ground truth, columns = decision (plus a column for "unknown" decisions).
 class ConfusionMatrix
@@ -63,21 +54,6 @@ private:
  *        the same world position. Returns the number of cells compared.
  */
 std::uint64_t accumulate(const ClassGrid& truth, const ClassGrid& decision, ConfusionMatrix& m);
-
-/// One ground-truth object at one instant.
-struct TruthObject
-{
-  std::uint32_t id = 0;
-  core::CellClass cell_class = core::CellClass::kMoving;
-  std::string kind;
-  core::Point2 centre;
-  double yaw = 0.0;
-  double length = 0.0;
-  double width = 0.0;
-  double speed = 0.0;  ///< m/s
-  /// True when p lies in the object's footprint.
-  bool contains(core::Point2 p) const;
-};
 
 /// Object-level scores accumulated scan after scan.
 class ObjectScorer
@@ -140,14 +116,21 @@ struct VariantScores
   std::string description;
   ConfusionMatrix confusion;
   ObjectScorer objects;
+  MoverScorer movers;  ///< moving objects per object (eval/movers.hpp); empty when nothing was added
   std::uint64_t scans = 0;
 };
 
-/// A flat, self-explaining map of metric names ("moving.recall", "objects.moving.detection_rate"…) to values.
+/// A flat, self-explaining map of metric names ("moving.recall", "objects.moving.detection_rate"…) to values;
+/// with movers scored, also MoverScorer::summary()'s keys.
 std::map<std::string, double> flatten(const VariantScores& v);
 
-/// metrics.json: {"variants": {name: {"description": …, metric: value…}}, "meta": {…}}.
+/// metrics.json: {"variants": {name: {"description": …, metric: value…, "movers_objects": {…}}}, "meta": {…}};
+/// "movers_objects" (moverObjectsJson()) only when movers were scored.
 std::string toJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta);
+
+/// metrics.json of labelled boxes (no class grid): {"meta": {…}, "variants": {name: {"description": …, "scans": …,
+/// MoverScorer::summary()'s keys…, "movers_objects": {…}}}}.
+std::string moversJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta);
 
 /// A Markdown table, one row per variant.
 std::string toMarkdown(const std::vector<VariantScores>& variants);
