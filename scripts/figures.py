@@ -6,7 +6,9 @@ Writes, next to metrics.json:
                      (b) PriorGrid, (c) MapGrid without prior, (d) MapGrid with prior (BetP colours)
   contact_sheet.png  the MapGrid decision (with prior) every few seconds of the drive, ground truth boxes on top
   scores_over_time.png  per-class recall over time, with and without the prior
-usage: figures.py OUT_DIR
+  movers_timeline.png   per moving object, its decision sweep by sweep (V / S / other / unseen), per variant
+usage: figures.py OUT_DIR                  (a simulated drive: all four figures)
+       figures.py --kitti-tracking OUT_DIR  (labelled real objects: the timeline only)
 """
 import csv
 import json
@@ -176,12 +178,71 @@ def scores_over_time(out):
     plt.close(fig)
 
 
+# Timeline states (eval/movers.hpp, SightingState): 0 unseen, 1 V, 2 S, 3 other; and not labelled moving.
+TIMELINE_COLOURS = {1: CLASS_COLOURS[4], 2: CLASS_COLOURS[3], 3: np.array([0.55, 0.55, 0.55]),
+                    0: np.array([0.85, 0.85, 0.85])}
+NOT_MOVING = np.array([1.0, 1.0, 1.0])
+TIMELINE_VARIANTS = ("default", "paper", "live", "live_default", "live_paper")
+
+
+def movers_timeline(out):
+    """Per mover, its state in each sweep: V red, S green, seen but neither grey, labelled but unseen light grey."""
+    metrics = json.loads((out / "metrics.json").read_text())
+    panels = [(name, metrics["variants"][name]["movers_objects"]) for name in TIMELINE_VARIANTS
+              if name in metrics["variants"] and "movers_objects" in metrics["variants"][name]]
+    panels = [(n, m) for n, m in panels if any(o["mover"] for o in m["objects"])]
+    if not panels:
+        return None
+    movers = [o for o in panels[0][1]["objects"] if o["mover"]]
+    height = 0.9 + 0.28 * len(movers) * len(panels)
+    fig, axes = plt.subplots(len(panels), 1, figsize=(12, height), squeeze=False, sharex=True)
+    for ax, (name, m) in zip(axes[:, 0], panels):
+        stamps = np.array(m["stamps"])
+        dt = float(np.median(np.diff(stamps))) if len(stamps) > 1 else 0.1
+        objs = [o for o in m["objects"] if o["mover"]]
+        labels = []
+        for row, o in enumerate(objs):
+            colours = np.tile(NOT_MOVING, (len(stamps), 1))
+            for scan, state in o["timeline"]:
+                colours[scan] = TIMELINE_COLOURS[state]
+            ax.imshow(colours[np.newaxis], extent=[stamps[0] - dt / 2, stamps[-1] + dt / 2, row + 0.1, row + 0.9],
+                      aspect="auto", interpolation="nearest")
+            delay = "never V" if o["delay_s"] is None else f"V after {o['delay_s']:.1f} s"
+            labels.append(f"{o['kind']} #{o['id']} ({o['max_speed']:.1f} m/s, {delay})")
+        ax.set_ylim(0, len(objs))
+        ax.set_yticks(np.arange(len(objs)) + 0.5)
+        ax.set_yticklabels(labels, fontsize=7)
+        ax.invert_yaxis()
+        ax.set_xlim(stamps[0] - dt / 2, stamps[-1] + dt / 2)
+        ax.set_title(f"{name}: each mover's decision per sweep", fontsize=9)
+    axes[-1, 0].set_xlabel("time [s]")
+    handles = [patches.Patch(color=TIMELINE_COLOURS[1], label="V (most of its cells moving)"),
+               patches.Patch(color=TIMELINE_COLOURS[2], label="S (most stopped)"),
+               patches.Patch(color=TIMELINE_COLOURS[3], label="seen, neither"),
+               patches.Patch(color=TIMELINE_COLOURS[0], label="labelled, too little seen"),
+               patches.Patch(facecolor=NOT_MOVING, edgecolor="black", label="not labelled moving")]
+    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    path = out / "movers_timeline.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
 def main():
-    out = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "out")
+    args = sys.argv[1:]
+    if args and args[0] == "--kitti-tracking":
+        out = pathlib.Path(args[1] if len(args) > 1 else "out/kitti_tracking")
+        path = movers_timeline(out)
+        print(f"wrote {path}" if path else f"no movers in {out / 'metrics.json'}")
+        return
+    out = pathlib.Path(args[0] if args else "out")
     figure2(out)
     contact_sheet(out)
     scores_over_time(out)
-    print(f"wrote {out / 'figure2.png'}, {out / 'contact_sheet.png'}, {out / 'scores_over_time.png'}")
+    movers_timeline(out)
+    print(f"wrote {out / 'figure2.png'}, {out / 'contact_sheet.png'}, {out / 'scores_over_time.png'}, "
+          f"{out / 'movers_timeline.png'}")
 
 
 if __name__ == "__main__":

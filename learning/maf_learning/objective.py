@@ -50,7 +50,34 @@ def pool(metrics_list):
     out["detected"] = detected / visible if visible else 0.0
     out["trail"] = trail / scans if scans else 0.0
     out["stopped_moving"] = stopped / scans if scans else 0.0
+    out["movers"] = pool_movers(metrics_list)
     return out
+
+
+HALF_SECOND = 0.5 + 1e-6  # s, "detected within 0.5 s" (stamps are rounded to ns)
+ONE_SECOND = 1.0 + 1e-6
+
+
+def pool_movers(metrics_list):
+    """Moving objects pooled over several drives' `evaluate` variants (their `movers_objects`, README "Scoring
+    moving objects"): movers seen, detected within 0.5 s and 1 s, never V, the median delay (never V counts as
+    infinite: None when more than half never are), the mean V share over movers, the S share of their cells."""
+    movers = [o for m in metrics_list for o in m.get("movers_objects", {}).get("objects", [])
+              if o["mover"] and o["first_seen_s"] is not None]
+    delays = sorted(float("inf") if o["delay_s"] is None else o["delay_s"] for o in movers)
+    median = None
+    if delays:
+        n = len(delays)
+        median = delays[n // 2] if n % 2 else 0.5 * (delays[n // 2 - 1] + delays[n // 2])
+        median = None if median == float("inf") else median
+    cells = sum(o["occupied_cells"] for o in movers)
+    return {"seen": len(movers),
+            "within_0_5s": sum(d <= HALF_SECOND for d in delays),
+            "within_1s": sum(d <= ONE_SECOND for d in delays),
+            "never": sum(o["delay_s"] is None for o in movers),
+            "median_delay_s": median,
+            "mean_v_share": sum(o["v_share"] for o in movers) / len(movers) if movers else 0.0,
+            "s_share": sum(o["s_share"] * o["occupied_cells"] for o in movers) / cells if cells else 0.0}
 
 
 def score(pooled, reference=None):

@@ -407,6 +407,20 @@ def _report_markdown(a, study, best, splits, pooled, kitti):
                        + f" | {p['v_precision']:.3f} | {p['v_recall']:.3f} | {p['moving_detected']}/"
                        f"{p['moving_visible']} | {p['stopped_moving']:.3f} | {p['trail']:.1f} | "
                        f"{obj.score(p, ref):.4f} |")
+    out.append("\n## Moving objects (pooled per split; doc/evaluation.md, \"Scoring moving objects\")\n")
+    out.append("| drives | variant | movers seen | detected ≤ 0.5 s | detected ≤ 1 s | never V | median delay (s) | "
+               "mean V share | S share (cells) |")
+    out.append("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for split, _ in splits:
+        for name, desc in VARIANTS:
+            p = pooled.get((split, name))
+            if not p:
+                continue
+            mv = p["movers"]
+            median = "never" if mv["median_delay_s"] is None else f"{mv['median_delay_s']:.1f}"
+            out.append(f"| {split.replace('_', '-')} | {desc} | {mv['seen']} | {mv['within_0_5s']}/{mv['seen']} | "
+                       f"{mv['within_1s']}/{mv['seen']} | {mv['never']} | {median} | {mv['mean_v_share']:.2f} | "
+                       f"{mv['s_share']:.2f} |")
     if kitti:
         out.append("\n## Real KITTI 00 frames 0–9 (never used for learning; no map)\n")
         out.append("| variant | V cells / sweep | false V / labelled sweep | V on static points / labelled sweep | "

@@ -416,6 +416,7 @@ std::string moverObjectsJson(const MoverScorer& scorer)
         << ", \"first_seen_s\": " << (r.first_seen >= 0.0 ? jsonNumber(r.first_seen - t0) : "null")
         << ", \"first_detected_s\": " << (r.first_detected >= 0.0 ? jsonNumber(r.first_detected - t0) : "null")
         << ", \"delay_s\": " << (r.delay() >= 0.0 ? jsonNumber(r.delay()) : "null")
+        << ", \"seen_scans\": " << r.seen_moving << ", \"occupied_cells\": " << r.occupied
         << ", \"v_share\": " << jsonNumber(r.vShare()) << ", \"v_cell_share\": " << jsonNumber(r.vCellShare())
         << ", \"s_share\": " << jsonNumber(r.sShare()) << ", \"parked_v_share\": "
         << (r.parked_occupied ? jsonNumber(static_cast<double>(r.parked_v) / static_cast<double>(r.parked_occupied))

@@ -1,6 +1,8 @@
 // evaluate: runs the core pipeline offline on a scenario bag (no ROS master) with ablation variants,
 // optionally scores a bag recorded from the live nodelets, and writes metrics.json, metrics.md, a per-scan
 // CSV and snapshots (NumPy arrays) for scripts/figures.py.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -57,7 +59,7 @@ constexpr int kProgressWidth = 40;
 struct Options
 {
   std::string bag;
-  std::string output_bag;
+  std::vector<std::pair<std::string, std::string>> output_bags;  ///< (row name, live recording)
   std::string live_topic = "/map_aided_fusion/decision";
   std::string out = "out";
   std::string fusion_config;
@@ -79,15 +81,15 @@ struct Options
 
 void usage()
 {
-  std::cerr << "usage: evaluate --bag SCENARIO.bag [--output-bag LIVE.bag] [--out DIR]\n"
+  std::cerr << "usage: evaluate --bag SCENARIO.bag [--output-bag [NAME=]LIVE.bag ...] [--out DIR]\n"
                "                [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
                "                [--pose-covariance-topic T] (softens the prior by the sigma of T)\n"
                "                [--map FILE] [--origin LAT,LON[,ALT]] [--snapshot-time S] [--sheet-period S]\n"
                "                [--match-radius M] [--no-ablations] [--only VARIANT[,VARIANT...]] [--quiet]\n"
                "       evaluate --check-config [--fusion-config F.yaml] [--scan-grid-config S.yaml] [--prior-config P.yaml]\n"
                "  Runs the pipeline offline on the bag with the configured method (variant `default`), the\n"
-               "  paper's exact method (`paper`) and their ablations, scores a bag recorded from the live\n"
-               "  nodelets (topic /map_aided_fusion/decision) when given, and writes DIR/metrics.json,\n"
+               "  paper's exact method (`paper`) and their ablations, scores bags recorded from the live\n"
+               "  nodelets (topic /map_aided_fusion/decision) when given (row `live`, or NAME), and writes DIR/metrics.json,\n"
                "  DIR/metrics.md, DIR/scores.csv and DIR/snapshots/.\n"
                "  A simulator bag (/ground_truth/classes, /ground_truth/objects) is scored per cell and per object;\n"
                "  a labelled real bag (/ground_truth/points, from kitti_to_bag) per labelled point: false V (V cells\n"
@@ -218,9 +220,11 @@ struct Variant
   }
 };
 
+/// A progress bar rewritten in place, only on a terminal (logs get no carriage returns).
 void progress(bool quiet, std::size_t done, std::size_t total, const char* what)
 {
-  if (quiet || total == 0) return;
+  static const bool terminal = ::isatty(STDERR_FILENO);
+  if (quiet || total == 0 || !terminal) return;
   const int filled = static_cast<int>(kProgressWidth * done / total);
   std::fprintf(stderr, "\r%-10s [%s%s] %zu/%zu", what, std::string(filled, '#').c_str(),
                std::string(kProgressWidth - filled, ' ').c_str(), done, total);
@@ -253,7 +257,15 @@ Options parse(int argc, char** argv)
       return argv[++i];
     };
     if (a == "--bag") o.bag = value();
-    else if (a == "--output-bag") o.output_bag = value();
+    else if (a == "--output-bag")
+    {
+      const std::string v = value();
+      const auto eq = v.find('=');
+      if (eq != std::string::npos && eq > 0 && v.find('/') > eq)
+        o.output_bags.emplace_back(v.substr(0, eq), v.substr(eq + 1));
+      else
+        o.output_bags.emplace_back("live", v);
+    }
     else if (a == "--live-topic") o.live_topic = value();
     else if (a == "--out") o.out = value();
     else if (a == "--fusion-config") o.fusion_config = value();
@@ -356,12 +368,12 @@ std::string moversSection(const std::vector<eval::VariantScores>& scores, bool o
   {
     if (v.movers.stamps().empty()) continue;
     all_rows.emplace_back(v.name, &v.movers);
-    if (v.name == "default" || v.name == "paper" || v.name == "live") main_rows.emplace_back(v.name, &v.movers);
+    if (v.name == "default" || v.name == "paper" || v.name.rfind("live", 0) == 0) main_rows.emplace_back(v.name, &v.movers);
   }
   if (all_rows.empty()) return "";
   std::ostringstream out;
   out << (objects_only ? "" : "## Moving objects\n\n")
-      << "Movers per kind (README, \"Scoring moving objects\": seen, V, S and false V defined there):\n\n"
+      << "Movers per kind (doc/evaluation.md, \"Scoring moving objects\", defines seen, V, S and false V):\n\n"
       << eval::moversMarkdown(main_rows, true);
   if (all_rows.size() > main_rows.size())
     out << "\nEvery variant, all kinds:\n\n" << eval::moversMarkdown(all_rows, false);
@@ -824,13 +836,14 @@ int main(int argc, char** argv)
     for (const auto& v : variants) scores.push_back(v->scores);
 
     // The live nodelets' decisions, when recorded.
-    eval::PointLabelScorer live_points(opt.match_radius);
-    if (!opt.output_bag.empty())
+    std::vector<std::unique_ptr<eval::PointLabelScorer>> live_points;
+    for (const auto& [live_name, live_path] : opt.output_bags)
     {
+      live_points.push_back(std::make_unique<eval::PointLabelScorer>(opt.match_radius));
       rosbag::Bag live;
-      live.open(opt.output_bag, rosbag::bagmode::Read);
+      live.open(live_path, rosbag::bagmode::Read);
       eval::VariantScores s;
-      s.name = "live";
+      s.name = live_name;
       s.description = "the three nodelets running on the replayed bag (rosbag play --clock), decisions recorded from " +
                       opt.live_topic;
       rosbag::View lv(live, rosbag::TopicQuery(std::vector<std::string>{ opt.live_topic }));
@@ -854,7 +867,7 @@ int main(int argc, char** argv)
               if (auto c = pm.instantiate<sensor_msgs::PointCloud2>())
                 if (c->header.stamp == d->header.stamp) points = toLabelledPoints(*c, tf, opt, configured.scan_grid);
           }
-          live_points.add(d->header.stamp.toSec(), decision, points, labelled);
+          live_points.back()->add(d->header.stamp.toSec(), decision, points, labelled);
           ++s.scans;
           continue;
         }
@@ -873,7 +886,7 @@ int main(int argc, char** argv)
         scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision, objects, gt);
         ++s.scans;
       }
-      if (s.scans == 0) std::cerr << "evaluate: no decision of " << opt.output_bag << " matches the bag's stamps\n";
+      if (s.scans == 0) std::cerr << "evaluate: no decision of " << live_path << " matches the bag's stamps\n";
       scores.push_back(s);
     }
     bag.close();
@@ -897,7 +910,8 @@ int main(int argc, char** argv)
     {
       std::vector<std::pair<std::string, const eval::PointLabelScorer*>> rows;
       for (const auto& v : variants) rows.emplace_back(v->scores.name, &v->points);
-      if (!opt.output_bag.empty()) rows.emplace_back("live", &live_points);
+      for (std::size_t l = 0; l < opt.output_bags.size(); ++l)
+        rows.emplace_back(opt.output_bags[l].first, live_points[l].get());
       markdown = eval::pointLabelMarkdown(rows);
       std::ofstream json(fs::path(opt.out) / "metrics.json");
       json << "{\n  \"meta\": {";

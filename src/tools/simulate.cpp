@@ -1,6 +1,8 @@
 // rosrun map_aided_fusion simulate --scenario scenarios/default.yaml --out x.bag
 //   [--duration S] [--preset ibeo4|vlp32|hdl32|hdl64] [--seed N] [--quiet]
 // Loads the scenario and its map, simulates every scan and writes the bag (see ros/sim_bag.hpp).
+#include <unistd.h>
+
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -107,7 +109,8 @@ int main(int argc, char** argv)
                 << " mapped but absent\n";
     SimBagOptions options;
     options.path = out_file;
-    options.progress = quiet ? nullptr : &std::cerr;
+    // A progress line rewritten in place only on a terminal (logs get no carriage returns).
+    options.progress = quiet || !::isatty(STDERR_FILENO) ? nullptr : &std::cerr;
     const SimBagStats stats = writeSimulationBag(simulator, options);
     std::cerr << "[simulate] wrote " << out_file << ": " << stats.scans << " scans, " << stats.points << " points, "
               << stats.tf_messages << " tf in " << stats.wall_seconds << " s\n";

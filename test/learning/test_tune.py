@@ -102,7 +102,8 @@ def test_report_writes_the_learned_profile_and_the_table(study_dir, tools):
     assert ibeo["mu_free"] == pytest.approx(best.params["scan_grid.mu_free"], abs=1e-6)
     assert space.check_config_dir(tools["evaluate"], str(out)) is None
     text = table.read_text()
-    for row in ("| training | paper's method", "| held-out | learned profile", "Dempster's rule", "Held-out verdict"):
+    for row in ("| training | paper's method", "| held-out | learned profile", "Dempster's rule", "Held-out verdict",
+                "## Moving objects (pooled per split", "| held-out | default profile (`config/`) |"):
         assert row in text, row
 
 

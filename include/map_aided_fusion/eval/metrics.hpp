@@ -116,8 +116,8 @@ struct VariantScores
   std::string description;
   ConfusionMatrix confusion;
   ObjectScorer objects;
-  MoverScorer movers;  ///< moving objects per object (eval/movers.hpp); empty when nothing was added
   std::uint64_t scans = 0;
+  MoverScorer movers = MoverScorer{};  ///< moving objects per object (eval/movers.hpp); empty when nothing was added
 };
 
 /// A flat, self-explaining map of metric names ("moving.recall", "objects.moving.detection_rate"…) to values;

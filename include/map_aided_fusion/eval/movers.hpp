@@ -5,7 +5,7 @@
  *        S; summaries per kind; false V where the labels are valid. The same code scores simulated drives (cells
  *        of the ground-truth class grid) and real labelled drives (lidar returns inside labelled boxes).
  *
- * Definitions (README, "Scoring moving objects"):
+ * Definitions (doc/evaluation.md, "Scoring moving objects"):
  *  - an object's *occupied cells* in a scan: simulator, the cells of its footprint that the ground truth marks
  *    observed with its class; real data, the decision cells holding an obstacle return that lies in its box;
  *  - it is *seen* in a scan when it has at least min(min_cells, ⌈min_share · footprint cells⌉) occupied cells
@@ -206,7 +206,8 @@ std::string moversMarkdown(const std::vector<std::pair<std::string, const MoverS
 std::string moverObjectsMarkdown(const MoverScorer& scorer);
 /**
  * @brief JSON of a scorer's objects: {"stamps": [...], "objects": [{"id", "kind", "group", "mover", "max_speed",
- *        "first_seen_s", "first_detected_s", "delay_s", "v_share", "v_cell_share", "s_share", "parked_v_share",
+ *        "first_seen_s", "first_detected_s", "delay_s", "seen_scans", "occupied_cells" (while moving and seen),
+ *        "v_share", "v_cell_share", "s_share", "parked_v_share",
  *        "timeline": [[scan, state], ...]}, ...]}; states: 0 unseen, 1 V, 2 S, 3 other.
  */
 std::string moverObjectsJson(const MoverScorer& scorer);
