@@ -81,6 +81,34 @@ std::vector<int> hungarian(const std::vector<double>& a, int n, int m)
 
 }  // namespace
 
+namespace {
+
+/// The gated problem on the rows and columns of one connected component (indices into @p m); writes @p out.
+void solveComponent(const CostMatrix& m, const std::vector<int>& rows, const std::vector<int>& cols, double big,
+                    std::vector<int>& out)
+{
+  const bool transpose = rows.size() > cols.size();
+  const int n = static_cast<int>(transpose ? cols.size() : rows.size());
+  const int k = static_cast<int>(transpose ? rows.size() : cols.size());
+  std::vector<double> a(static_cast<std::size_t>(n) * k);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < k; ++j)
+    {
+      const int r = transpose ? rows[j] : rows[i], c = transpose ? cols[i] : cols[j];
+      a[static_cast<std::size_t>(i) * k + j] = m.allowed(r, c) ? m.at(r, c) : big;
+    }
+  const std::vector<int> small_to_large = hungarian(a, n, k);
+  for (int i = 0; i < n; ++i)
+  {
+    const int j = small_to_large[i];
+    if (j < 0) continue;
+    const int r = transpose ? rows[j] : rows[i], c = transpose ? cols[i] : cols[j];
+    if (m.allowed(r, c)) out[r] = c;
+  }
+}
+
+}  // namespace
+
 std::vector<int> solveAssignment(const CostMatrix& m)
 {
   if (m.rows < 0 || m.cols < 0 ||
@@ -88,6 +116,15 @@ std::vector<int> solveAssignment(const CostMatrix& m)
     throw std::invalid_argument("solveAssignment: the cost matrix does not hold rows x cols values");
   std::vector<int> out(m.rows, -1);
   if (m.rows == 0 || m.cols == 0) return out;
+  // Rows and columns linked by allowed pairs form independent problems: solved one by one, the result is that of
+  // the whole matrix (a pairing is the union of its components' pairings), at a fraction of the cost when the gate
+  // leaves the matrix sparse.
+  std::vector<int> parent(static_cast<std::size_t>(m.rows + m.cols));
+  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto root = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
   double allowed_sum = 0.0;
   bool any = false;
   for (int r = 0; r < m.rows; ++r)
@@ -97,28 +134,17 @@ std::vector<int> solveAssignment(const CostMatrix& m)
         if (m.at(r, c) < 0.0) throw std::invalid_argument("solveAssignment: negative cost");
         allowed_sum += m.at(r, c);
         any = true;
+        const int a = root(r), b = root(m.rows + c);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
       }
   if (!any) return out;
   // Larger than any pairing's allowed cost: one more allowed pair always lowers the total.
   const double big = 2.0 * allowed_sum + 1.0;
-  const bool transpose = m.rows > m.cols;
-  const int n = transpose ? m.cols : m.rows;
-  const int k = transpose ? m.rows : m.cols;
-  std::vector<double> a(static_cast<std::size_t>(n) * k);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < k; ++j)
-    {
-      const int r = transpose ? j : i, c = transpose ? i : j;
-      a[static_cast<std::size_t>(i) * k + j] = m.allowed(r, c) ? m.at(r, c) : big;
-    }
-  const std::vector<int> small_to_large = hungarian(a, n, k);
-  for (int i = 0; i < n; ++i)
-  {
-    const int j = small_to_large[i];
-    if (j < 0) continue;
-    const int r = transpose ? j : i, c = transpose ? i : j;
-    if (m.allowed(r, c)) out[r] = c;
-  }
+  std::vector<std::vector<int>> comp_rows(parent.size()), comp_cols(parent.size());
+  for (int r = 0; r < m.rows; ++r) comp_rows[root(r)].push_back(r);
+  for (int c = 0; c < m.cols; ++c) comp_cols[root(m.rows + c)].push_back(c);
+  for (std::size_t k = 0; k < parent.size(); ++k)
+    if (!comp_rows[k].empty() && !comp_cols[k].empty()) solveComponent(m, comp_rows[k], comp_cols[k], big, out);
   return out;
 }
 

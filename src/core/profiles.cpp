@@ -51,7 +51,9 @@ Profile withoutAddedSteps(Profile p)
 
 Profile paperProfile()
 {
-  return withoutAddedSteps(Profile{});
+  Profile p = withoutAddedSteps(Profile{});
+  p.tracker.enabled = false;
+  return p;
 }
 
 }  // namespace core

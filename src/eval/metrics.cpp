@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <sstream>
 
 namespace map_aided_fusion {
@@ -261,6 +262,8 @@ std::map<std::string, double> flatten(const VariantScores& v)
   m["scans"] = static_cast<double>(v.scans);
   if (!v.movers.stamps().empty())
     for (const auto& [k, x] : v.movers.summary()) m[k] = x;
+  if (v.tracks.frames() > 0)
+    for (const auto& [k, x] : v.tracks.summary()) m["tracks." + k] = x;
   return m;
 }
 
@@ -316,9 +319,70 @@ std::string moversJson(const std::vector<VariantScores>& variants, const std::ma
     out << (i ? ",\n" : "\n") << "    \"" << escape(v.name) << "\": {\n      \"description\": \"" << escape(v.description)
         << "\",\n      \"scans\": " << v.scans;
     for (const auto& [k, x] : v.movers.summary()) out << ",\n      \"" << k << "\": " << number(x);
+    if (v.tracks.frames() > 0)
+      for (const auto& [k, x] : v.tracks.summary()) out << ",\n      \"tracks." << k << "\": " << number(x);
     out << ",\n      \"movers_objects\": " << moverObjectsJson(v.movers) << "\n    }";
   }
   out << "\n  }\n}\n";
+  return out.str();
+}
+
+std::vector<MotObject> motObjects(const std::vector<TruthObject>& objects, const std::vector<ObjectSighting>& sightings,
+                                  const MoverScorer& scorer)
+{
+  std::set<std::uint32_t> seen;
+  for (const ObjectSighting& s : sightings)
+    if (s.motion == MotionTruth::kMoving && scorer.seen(s)) seen.insert(s.id);
+  std::vector<MotObject> out;
+  out.reserve(objects.size());
+  for (const TruthObject& o : objects)
+  {
+    if (o.cell_class != CellClass::kMoving && o.cell_class != CellClass::kStopped &&
+        o.cell_class != CellClass::kUnknown)
+      continue;
+    MotObject m;
+    m.id = o.id;
+    m.position = o.centre;
+    m.judged = o.cell_class == CellClass::kMoving && seen.count(o.id);
+    m.has_velocity = true;
+    m.velocity = core::Point2{ o.vx, o.vy };
+    out.push_back(m);
+  }
+  return out;
+}
+
+std::string tracksMarkdown(const std::vector<VariantScores>& variants)
+{
+  std::ostringstream out;
+  char buf[64];
+  auto f = [&buf](double v, int digits) {
+    if (!std::isfinite(v)) return std::string("–");
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    return std::string(buf);
+  };
+  bool any = false;
+  for (const auto& v : variants) any = any || v.tracks.frames() > 0;
+  if (!any) return "";
+  out << "| variant | MOTA | MOTP (m) | movers × sweeps | matched | misses | false positives | id switches | "
+         "fragmentations | velocity RMSE (m/s) | velocity median (m/s) |\n";
+  out << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const auto& v : variants)
+  {
+    const ClearMot& t = v.tracks;
+    if (t.frames() == 0) continue;
+    out << "| " << v.name << " | " << f(t.mota(), 3) << " | " << f(t.motp(), 2) << " | " << t.objects() << " | "
+        << t.matches() << " | " << t.misses() << " | " << t.falsePositives() << " | " << t.idSwitches() << " | "
+        << t.fragmentations() << " | " << f(t.velocityRmse(), 2) << " | " << f(t.velocityMedian(), 2) << " |\n";
+  }
+  for (const auto& v : variants)
+  {
+    if (v.tracks.frames() == 0 || (v.name != "default" && v.name.rfind("live", 0) != 0)) continue;
+    out << "\nPer mover, tracks of `" << v.name << "`:\n\n| id | sweeps moving | tracked as moving | identity share | "
+           "id switches | fragmentations |\n| ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    for (const MotObjectRecord& r : v.tracks.records())
+      out << "| " << r.id << " | " << r.frames << " | " << r.tracked_frames << " | " << f(r.identity_share, 2) << " | "
+          << r.id_switches << " | " << r.fragmentations << " |\n";
+  }
   return out.str();
 }
 

@@ -254,7 +254,7 @@ void MoverScorer::add(double stamp, const std::vector<ObjectSighting>& sightings
       r.group = groupOf(s.kind);
     }
     r.max_speed = std::max(r.max_speed, s.speed);
-    const bool seen = s.occupied_cells > 0 && s.occupied_cells >= rule_.needed(s.footprint_cells);
+    const bool seen = this->seen(s);
     const std::uint32_t v = s.decidedAs(CellClass::kMoving), st = s.decidedAs(CellClass::kStopped);
     if (s.motion == MotionTruth::kMoving)
     {

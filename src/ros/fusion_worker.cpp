@@ -84,6 +84,7 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   , fused_window_(node_params_.health.diagnostic_window)
   , lost_window_(node_params_.health.diagnostic_window)
   , covariance_rejected_window_(node_params_.health.diagnostic_window)
+  , tracker_resets_window_(node_params_.health.diagnostic_window)
   , tf_listener_(tf_buffer_, nh)
   , reconfigure_(pnh)
 {
@@ -94,6 +95,12 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   navigable_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("navigable", 1);
   cells_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("cells", 1);
   objects_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("objects", 1);
+  if (const core::TrackerParams tp = loadTrackerParams(pnh); tp.enabled)
+  {
+    tracker_.emplace(tp);
+    tracks_pub_ = nh_.advertise<TrackedObjectArray>("tracks", 1);
+    tracks_markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("tracks/markers", 1);
+  }
 
   const auto queue = static_cast<uint32_t>(node_params_.tf_queue_size);
   scan_filter_ =
@@ -293,6 +300,7 @@ void FusionWorker::resetForTimeJump(const std::string& why)
 {
   ROS_WARN_STREAM("fusion: " << why << "; resetting the MapGrid and clearing the tf buffer");
   grid_.reset();
+  if (tracker_) tracker_->reset();
   stamp_guard_.reset();
   last_pose_.reset();
   tf_buffer_.clear();
@@ -485,6 +493,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   header.stamp = msg->header.stamp;
   header.frame_id = node_params_.map_frame;
   publish(header, prior);
+  if (tracker_) track(header, stamp, pose, obstacles);
   last_total_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 
@@ -541,6 +550,42 @@ void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWind
   }
 }
 
+void FusionWorker::track(const std_msgs::Header& header, double stamp, const core::Pose2& pose,
+                          const core::ObstaclePoints& returns)
+{
+  const core::GridGeometry& g = grid_.geometry();
+  const core::MapMassGrid& masses = grid_.masses();
+  core::backgroundFlags(pose, returns, tracker_->params().background_zeta,
+                        [&](core::Point2 p) {
+                          core::CellIndex c;
+                          return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
+                        },
+                        background_);
+  tracker_->update(stamp, pose, returns, &background_);
+  if (tracker_->counts().resets > tracker_resets_seen_)
+  {
+    tracker_resets_seen_ = tracker_->counts().resets;
+    tracker_resets_window_.add(core::steadySeconds());
+    ROS_WARN("fusion: every track dropped (time went back or the vehicle pose jumped)");
+  }
+  last_tracks_ = last_moving_tracks_ = 0;
+  for (const core::Track& t : tracker_->tracks())
+  {
+    last_tracks_ += t.reported();
+    last_moving_tracks_ += t.reported() && t.motion == core::TrackMotion::kMoving;
+  }
+  if (tracks_pub_.getNumSubscribers() + tracks_markers_pub_.getNumSubscribers() == 0) return;
+  auto tracks = boost::make_shared<TrackedObjectArray>();
+  Visualization::tracksToMessage(tracker_->tracks(), header, stamp, node_params_.object_box_height, *tracks);
+  if (tracks_markers_pub_.getNumSubscribers() > 0)
+  {
+    auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
+    Visualization::tracksToMarkers(*tracks, *markers);
+    tracks_markers_pub_.publish(markers);
+  }
+  tracks_pub_.publish(tracks);
+}
+
 void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -588,6 +633,17 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("covariances rejected", counters_.covariance_rejected);
   status.add("sigma clamped (over the bound)", counters_.sigma_clamped);
   status.add("prior softenings", counters_.prior_softenings);
+  status.add("tracker", tracker_ ? "on" : "off");
+  if (tracker_)
+  {
+    const core::TrackerCounts& c = tracker_->counts();
+    status.add("tracks (last scan)", last_tracks_);
+    status.add("moving tracks (last scan)", last_moving_tracks_);
+    status.add("tracker resets in window", tracker_resets_window_.count(now));
+    status.add("tracker resets", c.resets);
+    status.add("tracks deleted (non-finite or too fast)", c.rejected_tracks);
+    status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
+  }
 }
 
 }  // namespace map_aided_fusion

@@ -23,4 +23,12 @@ core::MapGridParams loadMapGridParams(const ros::NodeHandle& nh)
   return p;
 }
 
+core::TrackerParams loadTrackerParams(const ros::NodeHandle& nh)
+{
+  core::TrackerParams p;
+  core::forEachParam(p, parameterServerReader(nh));
+  p.validate();
+  return p;
+}
+
 }  // namespace map_aided_fusion

@@ -1,5 +1,6 @@
 #include "map_aided_fusion/ros/visualization.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -13,6 +14,10 @@ namespace {
 constexpr float kCellHeight = 0.1f;
 constexpr float kLabelSize = 0.8f;
 constexpr double kLabelLift = 1.0;
+constexpr double kMinTrackBox = 0.3;     // m, the smallest drawn side of a track's box
+constexpr double kArrowShaft = 0.15;     // m
+constexpr double kArrowHead = 0.4;       // m
+constexpr double kTrackLabelSize = 1.5;  // m: readable from a car's length away at the default rviz zoom
 
 std_msgs::ColorRGBA rgba(float r, float g, float b, float a)
 {
@@ -125,6 +130,102 @@ void Visualization::objectsToMarkers(const std::vector<core::GridObject>& object
     label.text = text;
     out.markers.push_back(label);
     ++id;
+  }
+}
+
+void Visualization::tracksToMessage(const std::vector<core::Track>& tracks, const std_msgs::Header& header, double now,
+                                    double box_height, TrackedObjectArray& out)
+{
+  out.header = header;
+  out.objects.clear();
+  for (const core::Track& t : tracks)
+  {
+    if (!t.reported()) continue;
+    TrackedObject o;
+    o.id = t.id;
+    o.cell_class = t.motion == core::TrackMotion::kMoving    ? TrackedObject::MOVING
+                   : t.motion == core::TrackMotion::kStopped ? TrackedObject::STOPPED
+                                                             : TrackedObject::MOTION_UNKNOWN;
+    o.state = t.state == core::TrackState::kCoasting ? TrackedObject::COASTING : TrackedObject::CONFIRMED;
+    o.pose.position.x = t.x(0);
+    o.pose.position.y = t.x(1);
+    o.pose.position.z = 0.5 * box_height;
+    o.pose.orientation.z = std::sin(0.5 * t.extent_yaw);
+    o.pose.orientation.w = std::cos(0.5 * t.extent_yaw);
+    o.size.x = t.extent_length;
+    o.size.y = t.extent_width;
+    o.size.z = box_height;
+    o.velocity.x = t.x(2);
+    o.velocity.y = t.x(3);
+    const Eigen::Matrix2d pv = t.P.bottomRightCorner<2, 2>();
+    o.velocity_covariance = { pv(0, 0), pv(0, 1), pv(1, 0), pv(1, 1) };
+    o.speed_sigma = t.speedSigma();
+    o.age = t.age(now);
+    o.hits = static_cast<std::uint32_t>(t.hits);
+    out.objects.push_back(o);
+  }
+}
+
+void Visualization::tracksToMarkers(const TrackedObjectArray& tracks, visualization_msgs::MarkerArray& out)
+{
+  out.markers.clear();
+  visualization_msgs::Marker clear;
+  clear.header = tracks.header;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  out.markers.push_back(clear);
+  // One marker of each kind per track, its id the track's: rviz keeps it in place from scan to scan.
+  auto marker = [&](const char* ns, const TrackedObject& o, int type) {
+    visualization_msgs::Marker m;
+    m.header = tracks.header;
+    m.ns = ns;
+    m.id = static_cast<int>(o.id);
+    m.type = type;
+    m.action = visualization_msgs::Marker::ADD;
+    m.pose.orientation.w = 1.0;
+    return m;
+  };
+  for (const TrackedObject& o : tracks.objects)
+  {
+    const auto cls = static_cast<CellClass>(o.cell_class);
+    visualization_msgs::Marker box = marker("tracks/box", o, visualization_msgs::Marker::CUBE);
+    box.pose = o.pose;
+    box.scale.x = std::max(o.size.x, kMinTrackBox);
+    box.scale.y = std::max(o.size.y, kMinTrackBox);
+    box.scale.z = o.size.z;
+    box.color = classColour(cls);
+    box.color.a = o.state == TrackedObject::COASTING ? 0.25f : 0.6f;
+    out.markers.push_back(box);
+
+    visualization_msgs::Marker arrow = marker("tracks/velocity", o, visualization_msgs::Marker::ARROW);
+    geometry_msgs::Point a, b;
+    a.x = o.pose.position.x;
+    a.y = o.pose.position.y;
+    a.z = o.size.z;
+    b = a;
+    b.x += o.velocity.x;  // where it will be in one second
+    b.y += o.velocity.y;
+    arrow.points = { a, b };
+    arrow.scale.x = kArrowShaft;
+    arrow.scale.y = kArrowHead;
+    arrow.scale.z = kArrowHead;
+    arrow.color = box.color;
+    arrow.color.a = 1.0f;
+    out.markers.push_back(arrow);
+
+    visualization_msgs::Marker label = marker("tracks/label", o, visualization_msgs::Marker::TEXT_VIEW_FACING);
+    label.pose.position = o.pose.position;
+    label.pose.position.z = o.size.z + kLabelLift;
+    label.scale.z = kTrackLabelSize;
+    label.color = box.color;
+    label.color.a = 1.0f;
+    char text[96];
+    std::snprintf(text, sizeof text, "#%u %s %.1f m/s", o.id,
+                  cls == CellClass::kMoving    ? "moving"
+                  : cls == CellClass::kStopped ? "stopped"
+                                               : "motion unknown",
+                  std::hypot(o.velocity.x, o.velocity.y));
+    label.text = text;
+    out.markers.push_back(label);
   }
 }
 

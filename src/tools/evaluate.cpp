@@ -31,6 +31,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "map_aided_fusion/GroundTruthObjectArray.h"
+#include "map_aided_fusion/TrackedObjectArray.h"
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/core/prior_uncertainty.hpp"
@@ -61,6 +62,7 @@ struct Options
   std::string bag;
   std::vector<std::pair<std::string, std::string>> output_bags;  ///< (row name, live recording)
   std::string live_topic = "/map_aided_fusion/decision";
+  std::string live_tracks_topic = "/map_aided_fusion/tracks";
   std::string out = "out";
   std::string fusion_config;
   std::string scan_grid_config;
@@ -207,6 +209,8 @@ struct Variant
   const core::PriorWindow* last_prior = nullptr;  // the softener's prior given to the last update
   eval::ClassGrid decision;
   eval::PointLabelScorer points;
+  std::optional<core::Tracker> tracker;  ///< when the profile enables it
+  std::vector<std::uint8_t> background;  ///< per obstacle return: on static background (the tracker's input)
   Variant(const std::string& name, const std::string& description, const core::Profile& profile, bool prior,
           double match_radius)
     : grid(profile.map_grid)
@@ -215,6 +219,7 @@ struct Variant
     , prior_options(profile.prior)
     , points(match_radius)
   {
+    if (profile.tracker.enabled) tracker.emplace(profile.tracker);
     scores.name = name;
     scores.description = description;
   }
@@ -382,6 +387,14 @@ std::string moversSection(const std::vector<eval::VariantScores>& scores, bool o
   return out.str();
 }
 
+/// CLEAR-MOT of the tracker's moving tracks against the movers (doc/evaluation.md, "Tracks: CLEAR-MOT").
+std::string tracksSection(const std::vector<eval::VariantScores>& scores)
+{
+  const std::string table = eval::tracksMarkdown(scores);
+  if (table.empty()) return "";
+  return "\n## Tracks (CLEAR-MOT of the moving tracks against the movers, match distance 2 m)\n\n" + table;
+}
+
 void writeSnapshotNpy(const fs::path& dir, const std::string& stem, const eval::ClassGrid& g)
 {
   writeNpy(dir / (stem + "_decision.npy"), g.cells.data(),
@@ -413,6 +426,8 @@ int main(int argc, char** argv)
     core::Profile configured;
     configured.map_grid = fusionParams(fusion_cfg);
     configured.scan_grid = scanGridParams(scan_cfg);
+    core::forEachParam(configured.tracker, map_io::yamlReader(fusion_cfg));
+    configured.tracker.validate();
     if (opt.check_config)
     {
       priorGridParams(prior_cfg);
@@ -506,22 +521,26 @@ int main(int argc, char** argv)
                                          configured.scan_grid.ground_height + configured.scan_grid.obstacle_max_height };
     // Labelled boxes: each sweep's obstacle returns in each box (map frame), for the offline and the live scores.
     std::map<std::int64_t, std::vector<eval::ObjectReturns>> object_returns;
+    // Adds the scan to @p movers; returns its sightings (CLEAR-MOT judges the movers seen in them).
     auto scoreMovers = [&](eval::MoverScorer& movers, double t, const ros::Time& stamp, const eval::ClassGrid& decision,
                            const std::vector<eval::TruthObject>* objects, const eval::ClassGrid* gt) {
       const std::vector<eval::TruthObject> none;
       const auto& objs = objects ? *objects : none;
+      std::vector<eval::ObjectSighting> sightings;
       if (object_mode)
       {
         const auto r = object_returns.find(key(stamp));
         const eval::ClassGrid* valid = nearest(valid_masks, stamp);
         eval::ClassGrid nothing_valid;
-        movers.add(t, r == object_returns.end() ? std::vector<eval::ObjectSighting>{}
-                                                : eval::sightingsFromReturns(r->second, decision),
-                   eval::countFalseV(decision, valid ? valid : &nothing_valid, objs, opt.match_radius));
+        if (r != object_returns.end()) sightings = eval::sightingsFromReturns(r->second, decision);
+        movers.add(t, sightings, eval::countFalseV(decision, valid ? valid : &nothing_valid, objs, opt.match_radius));
       }
       else if (gt)
-        movers.add(t, eval::sightingsFromClassGrid(*gt, objs, decision),
-                   eval::countFalseV(decision, nullptr, objs, opt.match_radius));
+      {
+        sightings = eval::sightingsFromClassGrid(*gt, objs, decision);
+        movers.add(t, sightings, eval::countFalseV(decision, nullptr, objs, opt.match_radius));
+      }
+      return sightings;
     };
 
     std::vector<std::unique_ptr<Variant>> variants;
@@ -702,6 +721,30 @@ int main(int argc, char** argv)
         if (auto c = covariance_sigma.upper_bound(k); c != covariance_sigma.begin()) sigma = std::prev(c)->second;
         const core::PriorWindow* pw = v->use_prior ? v->softener.softened(sigma) : nullptr;
         v->grid.update(v->scan, pose, t, pw, nullptr, &obstacles);
+        if (v->tracker)
+        {
+          const auto& g = v->grid.geometry();
+          const auto& masses = v->grid.masses();
+          core::backgroundFlags(pose, obstacles, v->tracker->params().background_zeta,
+                                [&](core::Point2 p) {
+                                  core::CellIndex c;
+                                  return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
+                                },
+                                v->background);
+          v->tracker->update(t, pose, obstacles, &v->background);
+        }
+        auto scoreTracks = [&](const std::vector<eval::ObjectSighting>& sightings) {
+          if (!v->tracker || !objects || point_mode) return;
+          {
+            // Labelled boxes: only tracks where the labels are valid can be judged.
+            const eval::ClassGrid* valid = object_mode ? nearest(valid_masks, cloud->header.stamp) : nullptr;
+            std::vector<eval::MotHypothesis> hypotheses;
+            for (const core::Track& tr : v->tracker->tracks())
+              if (tr.reported() && tr.motion == core::TrackMotion::kMoving && (!object_mode || (valid && valid->at(tr.position()) > 0)))
+                hypotheses.push_back(eval::MotHypothesis{ tr.id, tr.position(), true, tr.velocity() });
+            v->scores.tracks.addFrame(eval::motObjects(*objects, sightings, v->scores.movers), hypotheses);
+          }
+        };
         v->last_prior = pw;
         v->decision.geometry = v->grid.geometry();
         v->decision.cells = v->grid.decisions();
@@ -719,7 +762,7 @@ int main(int argc, char** argv)
         }
         if (object_mode)
         {
-          scoreMovers(v->scores.movers, t, cloud->header.stamp, v->decision, objects, nullptr);
+          scoreTracks(scoreMovers(v->scores.movers, t, cloud->header.stamp, v->decision, objects, nullptr));
           int seen = 0, as_v = 0;
           for (const auto& [id, r] : v->scores.movers.records())
             if (!r.timeline.empty() && r.timeline.back().first + 1 == v->scores.movers.stamps().size())
@@ -737,7 +780,7 @@ int main(int argc, char** argv)
         const auto compared = eval::accumulate(*gt, v->decision, scan_confusion);
         v->scores.confusion.add(scan_confusion);
         v->scores.objects.add(t, *gt, objects ? *objects : std::vector<eval::TruthObject>{}, v->decision);
-        scoreMovers(v->scores.movers, t, cloud->header.stamp, v->decision, objects, gt);
+        scoreTracks(scoreMovers(v->scores.movers, t, cloud->header.stamp, v->decision, objects, gt));
         ++v->scores.scans;
         csv << (t - *t0) << "," << v->scores.name << "," << compared;
         for (int c = 0; c < core::kNumCellClasses; ++c)
@@ -846,6 +889,27 @@ int main(int argc, char** argv)
       s.name = live_name;
       s.description = "the three nodelets running on the replayed bag (rosbag play --clock), decisions recorded from " +
                       opt.live_topic;
+      // The live tracks, when recorded, for CLEAR-MOT.
+      std::map<std::int64_t, std::vector<eval::MotHypothesis>> live_tracks;
+      for (const rosbag::MessageInstance& m :
+           rosbag::View(live, rosbag::TopicQuery(std::vector<std::string>{ opt.live_tracks_topic })))
+        if (auto a = m.instantiate<TrackedObjectArray>())
+        {
+          auto& h = live_tracks[key(a->header.stamp)];
+          const eval::ClassGrid* valid = object_mode ? nearest(valid_masks, a->header.stamp) : nullptr;
+          for (const auto& o : a->objects)
+          {
+            const core::Point2 p{ o.pose.position.x, o.pose.position.y };
+            if (o.cell_class == TrackedObject::MOVING && (!object_mode || (valid && valid->at(p) > 0)))
+              h.push_back(eval::MotHypothesis{ o.id, p, true, core::Point2{ o.velocity.x, o.velocity.y } });
+          }
+        }
+      auto scoreLiveTracks = [&](const ros::Time& stamp, const std::vector<eval::TruthObject>* objects,
+                                 const std::vector<eval::ObjectSighting>& sightings) {
+        const auto h = live_tracks.find(key(stamp));
+        if (h == live_tracks.end() || !objects) return;
+        s.tracks.addFrame(eval::motObjects(*objects, sightings, s.movers), h->second);
+      };
       rosbag::View lv(live, rosbag::TopicQuery(std::vector<std::string>{ opt.live_topic }));
       const std::size_t total = lv.size();
       std::size_t k = 0;
@@ -873,8 +937,9 @@ int main(int argc, char** argv)
         }
         if (object_mode)
         {
-          scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision,
-                      nearest(truth_objects, d->header.stamp), nullptr);
+          const auto* objects = nearest(truth_objects, d->header.stamp);
+          scoreLiveTracks(d->header.stamp, objects,
+                          scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision, objects, nullptr));
           ++s.scans;
           continue;
         }
@@ -883,7 +948,8 @@ int main(int argc, char** argv)
         eval::accumulate(*gt, decision, s.confusion);
         const auto* objects = nearest(truth_objects, d->header.stamp);
         s.objects.add(d->header.stamp.toSec(), *gt, objects ? *objects : std::vector<eval::TruthObject>{}, decision);
-        scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision, objects, gt);
+        scoreLiveTracks(d->header.stamp, objects,
+                        scoreMovers(s.movers, d->header.stamp.toSec(), d->header.stamp, decision, objects, gt));
         ++s.scans;
       }
       if (s.scans == 0) std::cerr << "evaluate: no decision of " << live_path << " matches the bag's stamps\n";
@@ -945,12 +1011,12 @@ int main(int argc, char** argv)
     {
       meta["valid_masks"] = std::to_string(valid_masks.size());
       std::ofstream(fs::path(opt.out) / "metrics.json") << eval::moversJson(scores, meta);
-      markdown = moversSection(scores, true);
+      markdown = moversSection(scores, true) + tracksSection(scores);
     }
     else
     {
       std::ofstream(fs::path(opt.out) / "metrics.json") << eval::toJson(scores, meta);
-      markdown = eval::toMarkdown(scores) + "\n" + moversSection(scores, false);
+      markdown = eval::toMarkdown(scores) + "\n" + moversSection(scores, false) + tracksSection(scores);
     }
     std::ofstream(fs::path(opt.out) / "metrics.md") << "# map_aided_fusion evaluation\n\nBag: `" << opt.bag << "`, "
                                                      << done << " scans"

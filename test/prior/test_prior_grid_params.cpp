@@ -181,6 +181,10 @@ TEST(Profiles, ConfigFilesHoldTheDefaultAndThePaperProfiles)
   EXPECT_EQ(valuesOf(loadFile<core::MapGridParams>(dir + "paper/fusion.yaml")), valuesOf(paper.map_grid));
   EXPECT_EQ(valuesOf(loadFile<core::ScanGridParams>(dir + "paper/scan_grid.yaml")), valuesOf(paper.scan_grid));
   EXPECT_NE(valuesOf(paper.map_grid), valuesOf(def.map_grid));
+  EXPECT_EQ(valuesOf(loadFile<core::TrackerParams>(dir + "fusion.yaml")), valuesOf(def.tracker));
+  EXPECT_EQ(valuesOf(loadFile<core::TrackerParams>(dir + "paper/fusion.yaml")), valuesOf(paper.tracker));
+  EXPECT_TRUE(def.tracker.enabled);
+  EXPECT_FALSE(paper.tracker.enabled);
   // The PriorGrid: the profiles' options (cell test, map accuracy); every other key the same in both files.
   const YAML::Node a = YAML::LoadFile(dir + "prior_grid.yaml"), b = YAML::LoadFile(dir + "paper/prior_grid.yaml");
   map_io::PriorGridParams pa, pb;

@@ -75,3 +75,59 @@ TEST(Visualization, ObjectsAreBoxesWithLabels)
   EXPECT_EQ(out.markers[4].text, "stopped 0.65");
   EXPECT_NE(out.markers[1].id, out.markers[3].id);
 }
+
+TEST(Visualization, TracksBecomeMessagesAndMarkersWithIdVelocityAndMotion)
+{
+  core::Track moving;
+  moving.id = 12;
+  moving.state = core::TrackState::kConfirmed;
+  moving.motion = core::TrackMotion::kMoving;
+  moving.x << 10.0, 5.0, 3.0, 4.0;
+  moving.P = Eigen::Matrix4d::Identity() * 0.04;
+  moving.extent_yaw = 0.5;
+  moving.extent_length = 4.2;
+  moving.extent_width = 1.8;
+  moving.hits = 7;
+  moving.first_stamp = 100.0;
+  core::Track coasting = moving;
+  coasting.id = 13;
+  coasting.state = core::TrackState::kCoasting;
+  coasting.motion = core::TrackMotion::kUnknown;
+  core::Track tentative = moving;
+  tentative.id = 14;
+  tentative.state = core::TrackState::kTentative;
+  std_msgs::Header h;
+  h.frame_id = "map";
+  h.stamp.fromSec(101.5);
+  TrackedObjectArray msg;
+  Visualization::tracksToMessage({ moving, coasting, tentative }, h, 101.5, 1.5, msg);
+  ASSERT_EQ(msg.objects.size(), 2u);  // the tentative track is not reported
+  const TrackedObject& o = msg.objects[0];
+  EXPECT_EQ(o.id, 12u);
+  EXPECT_EQ(o.cell_class, TrackedObject::MOVING);
+  EXPECT_EQ(o.cell_class, static_cast<int>(CellClass::kMoving));
+  EXPECT_EQ(o.state, TrackedObject::CONFIRMED);
+  EXPECT_DOUBLE_EQ(o.velocity.x, 3.0);
+  EXPECT_DOUBLE_EQ(o.velocity.y, 4.0);
+  EXPECT_DOUBLE_EQ(o.velocity_covariance[0], 0.04);
+  EXPECT_DOUBLE_EQ(o.velocity_covariance[1], 0.0);
+  EXPECT_NEAR(o.speed_sigma, 0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(o.age, 1.5);
+  EXPECT_DOUBLE_EQ(o.size.x, 4.2);
+  EXPECT_NEAR(2.0 * std::atan2(o.pose.orientation.z, o.pose.orientation.w), 0.5, 1e-12);
+  EXPECT_EQ(msg.objects[1].state, TrackedObject::COASTING);
+  EXPECT_EQ(msg.objects[1].cell_class, TrackedObject::MOTION_UNKNOWN);
+  EXPECT_EQ(msg.objects[1].cell_class, static_cast<int>(CellClass::kOccupied));
+
+  visualization_msgs::MarkerArray markers;
+  Visualization::tracksToMarkers(msg, markers);
+  ASSERT_EQ(markers.markers.size(), 1u + 3u * 2u);
+  EXPECT_EQ(markers.markers[0].action, visualization_msgs::Marker::DELETEALL);
+  const auto& arrow = markers.markers[2];
+  EXPECT_EQ(arrow.ns, "tracks/velocity");
+  ASSERT_EQ(arrow.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(arrow.points[1].x - arrow.points[0].x, 3.0);  // one second ahead
+  EXPECT_EQ(markers.markers[3].text, "#12 moving 5.0 m/s");
+  EXPECT_EQ(markers.markers[1].id, 12);  // the marker keeps the track's id from scan to scan
+  EXPECT_EQ(markers.markers[1].color.r, Visualization::classColour(CellClass::kMoving).r);
+}

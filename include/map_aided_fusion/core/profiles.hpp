@@ -13,6 +13,7 @@
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
+#include "map_aided_fusion/core/tracker.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -23,6 +24,7 @@ struct Profile
   ScanGridParams scan_grid;
   MapGridParams map_grid;
   PriorGridOptions prior;
+  TrackerParams tracker;  ///< tracked objects (config/fusion.yaml, tracker_*); off in the paper's method
 };
 
 /**

@@ -13,6 +13,7 @@
 
 #include "map_aided_fusion/core/cell_class.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
+#include "map_aided_fusion/eval/clear_mot.hpp"
 #include "map_aided_fusion/eval/movers.hpp"
 #include "map_aided_fusion/eval/truth.hpp"
 
@@ -118,10 +119,22 @@ struct VariantScores
   ObjectScorer objects;
   std::uint64_t scans = 0;
   MoverScorer movers = MoverScorer{};  ///< moving objects per object (eval/movers.hpp); empty when nothing was added
+  ClearMot tracks = ClearMot{};        ///< the tracker's moving tracks against the movers; no frame without a tracker
 };
 
+/**
+ * @brief The truth of one scan for CLEAR-MOT: movers seen in the scan (@p sightings, @p scorer's rule) are judged;
+ *        every other object (parked, ambiguous, a mover hidden or out of range) is not.
+ */
+std::vector<MotObject> motObjects(const std::vector<TruthObject>& objects, const std::vector<ObjectSighting>& sightings,
+                                  const MoverScorer& scorer);
+
+/// CLEAR-MOT per variant with tracks (Markdown): the counts, MOTA, MOTP, velocity errors, then per mover its
+/// identity share.
+std::string tracksMarkdown(const std::vector<VariantScores>& variants);
+
 /// A flat, self-explaining map of metric names ("moving.recall", "objects.moving.detection_rate"…) to values;
-/// with movers scored, also MoverScorer::summary()'s keys.
+/// with movers scored, also MoverScorer::summary()'s keys; with tracks, ClearMot::summary()'s as "tracks.*".
 std::map<std::string, double> flatten(const VariantScores& v);
 
 /// metrics.json: {"variants": {name: {"description": …, metric: value…, "movers_objects": {…}}}, "meta": {…}};

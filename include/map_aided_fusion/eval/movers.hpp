@@ -177,6 +177,9 @@ public:
    */
   void add(double stamp, const std::vector<ObjectSighting>& sightings, std::uint64_t false_v);
 
+  const SightingRule& rule() const { return rule_; }
+  /// True when @p s is seen by this scorer's rule.
+  bool seen(const ObjectSighting& s) const { return s.occupied_cells > 0 && s.occupied_cells >= rule_.needed(s.footprint_cells); }
   const std::vector<double>& stamps() const { return stamps_; }
   const std::map<std::uint32_t, MoverRecord>& records() const { return records_; }
   double falseVPerScan() const;

@@ -36,6 +36,7 @@ struct TruthObject
   double length = 0.0;
   double width = 0.0;
   double speed = 0.0;  ///< m/s
+  double vx = 0.0, vy = 0.0;  ///< m/s, map frame
   double z = 0.0;       ///< m, height of the box centre (map frame)
   double height = 0.0;  ///< m, box height (0: unknown)
   /// True when p lies in the object's footprint grown by @p margin metres on every side.

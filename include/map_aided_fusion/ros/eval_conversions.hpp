@@ -43,6 +43,8 @@ inline std::vector<eval::TruthObject> toTruthObjects(const GroundTruthObjectArra
     t.length = o.size.x;
     t.width = o.size.y;
     t.speed = std::hypot(o.velocity.x, o.velocity.y);
+    t.vx = o.velocity.x;
+    t.vy = o.velocity.y;
     t.z = o.pose.position.z;
     t.height = o.size.z;
     out.push_back(t);

@@ -25,6 +25,7 @@
 #include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "map_aided_fusion/core/sliding_window.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
+#include "map_aided_fusion/core/tracker.hpp"
 
 namespace map_aided_fusion {
 
@@ -105,6 +106,8 @@ private:
   void onReconfigure(FusionConfig& config, uint32_t level);
   /// Publishes the layers of the last update, whose prior was @p prior (nullptr: none).
   void publish(const std_msgs::Header& header, const core::PriorWindow* prior);
+  /// Updates the tracker with the scan's obstacle returns and publishes `tracks` and `tracks/markers`.
+  void track(const std_msgs::Header& header, double stamp, const core::Pose2& pose, const core::ObstaclePoints& returns);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
@@ -124,6 +127,11 @@ private:
   FusionCounters counters_;
   core::SlidingCounter fused_window_, lost_window_;
   core::SlidingCounter covariance_rejected_window_;
+  std::optional<core::Tracker> tracker_;  ///< when `tracker` is true (config/fusion.yaml)
+  std::vector<std::uint8_t> background_;   ///< per obstacle return of the scan: on static background
+  std::uint64_t tracker_resets_seen_ = 0;  ///< the tracker's resets already counted in the window
+  core::SlidingCounter tracker_resets_window_;
+  std::size_t last_tracks_ = 0, last_moving_tracks_ = 0;
   double start_wall_ = 0.0;
   double last_fused_wall_ = 0.0;
   core::StageTimes last_times_;
@@ -136,6 +144,7 @@ private:
   std::unique_ptr<tf2_ros::MessageFilter<EvidentialGrid>> scan_filter_;
   ros::Subscriber scan_sub_, prior_sub_, covariance_sub_;
   ros::Publisher map_grid_pub_, decision_pub_, navigable_pub_, cells_pub_, objects_pub_;
+  ros::Publisher tracks_pub_, tracks_markers_pub_;
   ros::Publisher betp_pub_[core::FrameMG::kSize];
   dynamic_reconfigure::Server<FusionConfig> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;

@@ -9,6 +9,7 @@
 #include <ros/node_handle.h>
 
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/tracker.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
 
 namespace map_aided_fusion {
@@ -36,5 +37,11 @@ inline auto parameterServerReader(const ros::NodeHandle& nh)
  * @throws core::ParameterError naming the parameter that is missing its type or out of range.
  */
 core::MapGridParams loadMapGridParams(const ros::NodeHandle& nh);
+
+/**
+ * @brief The tracker's parameters from @p nh (the fusion nodelet's private namespace, `tracker*` keys).
+ * @throws core::ParameterError naming the parameter that has the wrong type or is out of range.
+ */
+core::TrackerParams loadTrackerParams(const ros::NodeHandle& nh);
 
 }  // namespace map_aided_fusion

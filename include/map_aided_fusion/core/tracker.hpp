@@ -1,0 +1,230 @@
+/**
+ * @file tracker.hpp
+ * @brief Tracked objects (ROS-free): per scan, measurements from clusters of the scan's obstacle returns; tracks with
+ *        a constant-velocity Kalman filter, associated to the measurements by a gated global assignment
+ *        (core/assignment.hpp), with a lifecycle (tentative → confirmed → coasting → deleted) and a motion decision
+ *        from the velocity and its covariance (moving, stopped or not yet known).
+ *
+ * Not in the paper: it gives each object an id and a velocity, and the motion evidence the grid's classes lack
+ * (doc/evaluation.md scores it with CLEAR-MOT). The `paper` profile does not use it.
+ */
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "map_aided_fusion/core/grid_geometry.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+/// The tracker's parameters (config/fusion.yaml, `tracker_*`); units in the comments.
+struct TrackerParams
+{
+  bool enabled = true;               ///< run the tracker (false in the paper profile)
+  double cluster_distance = 0.6;     ///< m: returns in cells of half this size that touch are one cluster
+  int min_cluster_points = 12;       ///< a cluster with fewer returns is no measurement
+  /// A return on a MapGrid cell whose counter ζ is above this lies on static background (occupied scan after scan:
+  /// a facade, a parked car); ζ grows by delta_inc per consistent occupied scan …
+  double background_zeta = 0.4;
+  /// … and a cluster with more than this share of its returns on background is no moving-object candidate, not
+  /// tracked; 1: off.
+  double background_share = 0.5;
+  double max_object_length = 8.0;    ///< m: a longer cluster (a wall, a fence, a hedge) is no object
+  double max_object_width = 4.0;     ///< m: a wider cluster is no object
+  double measurement_sigma = 0.15;   ///< m, standard deviation of a compact cluster's centroid
+  double extent_sigma = 0.1;         ///< m of standard deviation per metre of the cluster's extent on that axis
+  double acceleration_sigma = 1.0;   ///< m/s², white-noise acceleration of the constant-velocity model
+  double initial_speed_sigma = 5.0;  ///< m/s, velocity standard deviation of a new track
+  double gate = 13.8;                ///< Mahalanobis² of an association (χ² with 2 dof: 13.8 is 99.9 %)
+  double max_gate_distance = 3.0;    ///< m: no association farther than this, whatever the covariance
+  int confirm_hits = 3;              ///< consecutive associations that confirm a tentative track
+  double max_coast_time = 0.5;       ///< s without an association before a confirmed track is deleted
+  double moving_speed = 0.5;         ///< m/s: moving when speed − motion_sigmas · σ(speed) is above this
+  double motion_sigmas = 1.5;        ///< how many standard deviations the speed must clear
+  double stopped_speed = 0.8;        ///< m/s: stopped when speed + motion_sigmas · σ(speed) stays below this …
+  double stopped_time = 1.0;         ///< s … for this long
+  double max_speed = 50.0;           ///< m/s: a track estimated faster is deleted (a wrong association)
+  double max_ego_speed = 70.0;       ///< m/s: a vehicle pose moving faster between two scans resets every track
+
+  /// @throws ParameterError naming the first parameter out of range.
+  void validate() const;
+};
+
+/// Calls get(name, field) for every parameter, with the names of config/fusion.yaml.
+template <class Get>
+void forEachParam(TrackerParams& p, Get&& get)
+{
+  get("tracker", p.enabled);
+  get("tracker_cluster_distance", p.cluster_distance);
+  get("tracker_min_cluster_points", p.min_cluster_points);
+  get("tracker_background_zeta", p.background_zeta);
+  get("tracker_background_share", p.background_share);
+  get("tracker_max_object_length", p.max_object_length);
+  get("tracker_max_object_width", p.max_object_width);
+  get("tracker_measurement_sigma", p.measurement_sigma);
+  get("tracker_extent_sigma", p.extent_sigma);
+  get("tracker_acceleration_sigma", p.acceleration_sigma);
+  get("tracker_initial_speed_sigma", p.initial_speed_sigma);
+  get("tracker_gate", p.gate);
+  get("tracker_max_gate_distance", p.max_gate_distance);
+  get("tracker_confirm_hits", p.confirm_hits);
+  get("tracker_max_coast_time", p.max_coast_time);
+  get("tracker_moving_speed", p.moving_speed);
+  get("tracker_motion_sigmas", p.motion_sigmas);
+  get("tracker_stopped_speed", p.stopped_speed);
+  get("tracker_stopped_time", p.stopped_time);
+  get("tracker_max_speed", p.max_speed);
+  get("tracker_max_ego_speed", p.max_ego_speed);
+}
+
+/**
+ * @brief Per return of @p returns (vehicle frame, vehicle pose @p pose): 1 when it lies on static background, i.e.
+ *        its map cell's counter @p zetaAt(map point) is above @p zeta_max (NaN or negative outside the grid: 0).
+ */
+template <class ZetaAt>
+void backgroundFlags(const Pose2& pose, const ObstaclePoints& returns, double zeta_max, ZetaAt&& zetaAt,
+                     std::vector<std::uint8_t>& flags)
+{
+  flags.assign(returns.count, 0);
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  for (std::size_t i = 0; i < returns.count; ++i)
+  {
+    const double x = returns.xy[2 * i], y = returns.xy[2 * i + 1];
+    flags[i] = zetaAt(Point2{ pose.x + c * x - s * y, pose.y + s * x + c * y }) > zeta_max;
+  }
+}
+
+/// One object seen in one scan: a cluster of obstacle returns (map frame).
+struct Measurement
+{
+  Point2 centroid;
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();  ///< of the centroid, m²
+  double yaw = 0.0;     ///< rad, the cluster's major axis
+  double length = 0.0;  ///< m, extent along the major axis
+  double width = 0.0;   ///< m, extent along the minor axis
+  /// The cluster's box relative to the centroid: [lo_u, hi_u] along the major axis, [lo_v, hi_v] along the minor.
+  double lo_u = 0.0, hi_u = 0.0, lo_v = 0.0, hi_v = 0.0;
+  int points = 0;
+  bool has_sensor = false;  ///< the sensor position is known (the end of a partly seen object nearest it is real)
+  Point2 sensor;            ///< map frame
+};
+
+/**
+ * @brief Clusters map-frame returns: cells of cluster_distance / 2 holding returns, 8-connected, are one cluster.
+ *        Clusters with fewer than min_cluster_points returns, longer than max_object_length or wider than
+ *        max_object_width, or (with @p background, one flag per point) with more than background_share of their
+ *        returns on background are dropped; non-finite points are skipped.
+ */
+std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& params,
+                                        const std::vector<std::uint8_t>* background = nullptr);
+
+/// Lifecycle of a track.
+enum class TrackState : std::uint8_t
+{
+  kTentative,  ///< fewer than confirm_hits associations so far
+  kConfirmed,
+  kCoasting,   ///< confirmed, not associated in the last scan(s)
+};
+
+/// Motion decision of a track.
+enum class TrackMotion : std::uint8_t
+{
+  kUnknown,
+  kMoving,
+  kStopped,
+};
+
+/// A tracked object. State x = (x, y, vx, vy) in the map frame, covariance P.
+struct Track
+{
+  std::uint32_t id = 0;
+  TrackState state = TrackState::kTentative;
+  TrackMotion motion = TrackMotion::kUnknown;
+  Eigen::Vector4d x = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d P = Eigen::Matrix4d::Identity();
+  double yaw = 0.0, length = 0.0, width = 0.0;  ///< of the last associated cluster
+  /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
+  double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;
+  int hits = 0;                                 ///< associations
+  int consecutive_hits = 0;
+  double first_stamp = 0.0;
+  double last_hit = 0.0;                        ///< stamp of the last association
+  double still_since = -1.0;                    ///< stamp since which it is confidently slow (−1: not)
+
+  Point2 position() const { return Point2{ x(0), x(1) }; }
+  Point2 velocity() const { return Point2{ x(2), x(3) }; }
+  double speed() const { return x.tail<2>().norm(); }
+  /// Standard deviation of the speed (along the velocity; the largest when the speed is near zero).
+  double speedSigma() const;
+  /// Seconds since the first association.
+  double age(double now) const { return now - first_stamp; }
+  bool reported() const { return state != TrackState::kTentative; }
+};
+
+/// What went wrong, counted since the start (diagnostics read differences).
+struct TrackerCounts
+{
+  std::uint64_t scans = 0;
+  std::uint64_t measurements = 0;
+  std::uint64_t tracks_created = 0;
+  std::uint64_t tracks_deleted = 0;
+  std::uint64_t resets = 0;             ///< every track dropped: a pose or time jump
+  std::uint64_t rejected_tracks = 0;    ///< deleted for a non-finite state or an implausible speed
+  std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
+};
+
+/**
+ * @brief The point of @p m that the track @p t follows: the centre of the track's box placed on the cluster. Along
+ *        each of the box's axes, when the cluster's extent differs from the box's by more than 0.3 m, the cluster's
+ *        end nearest the sensor is taken as the object's end (the rest is hidden, out of range, or not seen yet);
+ *        otherwise the middle of the cluster's extent. Without a sensor position, or a box, the centroid.
+ */
+Point2 referencePoint(const Track& t, const Measurement& m);
+
+/// The multi-object tracker.
+class Tracker
+{
+public:
+  /// @throws ParameterError when @p params are out of range.
+  explicit Tracker(const TrackerParams& params = TrackerParams{});
+
+  /**
+   * @brief One scan: @p returns in the vehicle frame (ScanGridBuilder::obstaclePoints()), the vehicle pose @p pose
+   *        in the map frame at @p stamp (s); @p background, when given, flags each return on static background
+   *        (backgroundFlags()). A stamp not after the last one, or a pose moving faster than max_ego_speed, resets
+   *        every track first (counted).
+   */
+  void update(double stamp, const Pose2& pose, const ObstaclePoints& returns,
+              const std::vector<std::uint8_t>* background = nullptr);
+  /// One scan's measurements (map frame), for tests and for callers that cluster themselves.
+  void update(double stamp, const std::vector<Measurement>& measurements);
+
+  const std::vector<Track>& tracks() const { return tracks_; }
+  const std::vector<Measurement>& measurements() const { return measurements_; }
+  const TrackerCounts& counts() const { return counts_; }
+  const TrackerParams& params() const { return params_; }
+  /// Drops every track (ids keep counting up).
+  void reset();
+
+private:
+  void predict(Track& t, double dt) const;
+  void correct(Track& t, const Measurement& m, double stamp) const;
+  void decideMotion(Track& t, double stamp) const;
+
+  TrackerParams params_;
+  std::vector<Track> tracks_;
+  std::vector<Measurement> measurements_;
+  std::vector<Point2> map_points_;
+  std::vector<std::uint8_t> map_flags_;
+  TrackerCounts counts_;
+  std::uint32_t next_id_ = 1;
+  double last_stamp_ = -1.0;
+  Pose2 last_pose_;
+};
+
+}  // namespace core
+}  // namespace map_aided_fusion

@@ -1,0 +1,512 @@
+#include "map_aided_fusion/core/tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include <Eigen/Eigenvalues>
+
+#include "map_aided_fusion/core/assignment.hpp"
+#include "map_aided_fusion/core/parameters.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+namespace {
+
+constexpr double kMinCellSize = 0.01;  // m
+constexpr double kMaxCellSize = 10.0;  // m
+constexpr double kTinySpeed = 1e-6;    // m/s: below, the speed's direction is undefined
+constexpr double kMinStep = 1e-6;      // s between two scans
+constexpr double kMaxDenseCells = 4e6;  // cells of the dense clustering grid (16 MB of indices) before a hash map
+constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
+
+std::int64_t cellKey(std::int64_t x, std::int64_t y) { return (x << 32) ^ (y & 0xffffffffLL); }
+
+bool finite(const Eigen::Vector4d& x, const Eigen::Matrix4d& p) { return x.allFinite() && p.allFinite(); }
+
+/// The measurement's covariance, grown by the change of the cluster's extent since the track's last cluster: a
+/// partially seen object's centroid is off by up to half the part not seen.
+Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m)
+{
+  const double dl = 0.5 * std::abs(m.length - t.length), dw = 0.5 * std::abs(m.width - t.width);
+  const Eigen::Vector2d major(std::cos(m.yaw), std::sin(m.yaw)), minor(-major.y(), major.x());
+  return m.covariance + dl * dl * major * major.transpose() + dw * dw * minor * minor.transpose();
+}
+
+}  // namespace
+
+void TrackerParams::validate() const
+{
+  requireInRange("tracker_cluster_distance", cluster_distance, 2.0 * kMinCellSize, 2.0 * kMaxCellSize);
+  requireInRange("tracker_min_cluster_points", min_cluster_points, 1, 1e6);
+  requireUnit("tracker_background_zeta", background_zeta);
+  requireUnit("tracker_background_share", background_share);
+  requirePositive("tracker_max_object_length", max_object_length);
+  requirePositive("tracker_max_object_width", max_object_width);
+  requirePositive("tracker_measurement_sigma", measurement_sigma);
+  requireInRange("tracker_extent_sigma", extent_sigma, 0.0, 10.0);
+  requirePositive("tracker_acceleration_sigma", acceleration_sigma);
+  requirePositive("tracker_initial_speed_sigma", initial_speed_sigma);
+  requirePositive("tracker_gate", gate);
+  requirePositive("tracker_max_gate_distance", max_gate_distance);
+  requireInRange("tracker_confirm_hits", confirm_hits, 1, 1000);
+  requireInRange("tracker_max_coast_time", max_coast_time, 0.0, 60.0);
+  requireInRange("tracker_moving_speed", moving_speed, 0.0, 100.0);
+  requireInRange("tracker_motion_sigmas", motion_sigmas, 0.0, 10.0);
+  requireInRange("tracker_stopped_speed", stopped_speed, 0.0, 100.0);
+  requireInRange("tracker_stopped_time", stopped_time, 0.0, 600.0);
+  requirePositive("tracker_max_speed", max_speed);
+  requirePositive("tracker_max_ego_speed", max_ego_speed);
+}
+
+std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
+                                        const std::vector<std::uint8_t>* background)
+{
+  const double cell = 0.5 * p.cluster_distance;
+  // Cells holding returns, each with its points; union-find over 8-connected cells. The cells are indexed in a dense
+  // local grid over the returns' bounding box, or a hash map when that box is too large (far outliers).
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const Point2& q : points)
+    if (std::isfinite(q.x) && std::isfinite(q.y))
+    {
+      x0 = std::min(x0, q.x);
+      y0 = std::min(y0, q.y);
+      x1 = std::max(x1, q.x);
+      y1 = std::max(y1, q.y);
+    }
+  if (x0 > x1) return {};
+  // Cells on the world lattice (the same cells from scan to scan), offset by a free border of one cell.
+  const double span_x = (x1 - x0) / cell + 4.0, span_y = (y1 - y0) / cell + 4.0;
+  const bool dense = span_x * span_y <= static_cast<double>(kMaxDenseCells);
+  const auto cx0 = dense ? static_cast<std::int64_t>(std::floor(x0 / cell)) - 1 : 0;
+  const auto cy0 = dense ? static_cast<std::int64_t>(std::floor(y0 / cell)) - 1 : 0;
+  const auto w = dense ? static_cast<std::int64_t>(span_x) : 0;
+  const auto h = dense ? static_cast<std::int64_t>(span_y) : 0;
+  std::vector<int> dense_index;
+  if (dense) dense_index.assign(static_cast<std::size_t>(w * h), -1);
+  std::unordered_map<std::int64_t, int> sparse_index;
+  auto slot = [&](std::int64_t cx, std::int64_t cy) -> int* {
+    if (dense)
+    {
+      cx -= cx0;
+      cy -= cy0;
+      return cx < 0 || cy < 0 || cx >= w || cy >= h ? nullptr : &dense_index[static_cast<std::size_t>(cy * w + cx)];
+    }
+    const auto it = sparse_index.find(cellKey(cx, cy));
+    return it == sparse_index.end() ? nullptr : &it->second;
+  };
+  std::vector<std::pair<std::int64_t, std::int64_t>> coords;
+  std::vector<int> cell_of(points.size(), -1);
+  for (int i = 0; i < static_cast<int>(points.size()); ++i)
+  {
+    const Point2 q = points[i];
+    if (!std::isfinite(q.x) || !std::isfinite(q.y)) continue;
+    const auto cx = static_cast<std::int64_t>(std::floor(q.x / cell));
+    const auto cy = static_cast<std::int64_t>(std::floor(q.y / cell));
+    int* s = dense ? slot(cx, cy) : &sparse_index.emplace(cellKey(cx, cy), -1).first->second;
+    if (*s < 0)
+    {
+      *s = static_cast<int>(coords.size());
+      coords.emplace_back(cx, cy);
+    }
+    cell_of[i] = *s;
+  }
+  std::vector<int> parent(coords.size());
+  for (std::size_t k = 0; k < parent.size(); ++k) parent[k] = static_cast<int>(k);
+  auto root = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t k = 0; k < coords.size(); ++k)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+      {
+        if (dx == 0 && dy == 0) continue;
+        const int* n = slot(coords[k].first + dx, coords[k].second + dy);
+        if (!n || *n < 0) continue;
+        const int a = root(static_cast<int>(k)), b = root(*n);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+  // Points per cluster, in point order; clusters numbered by their root cell.
+  std::vector<int> cluster_of_root(coords.size(), -1);
+  std::vector<std::vector<int>> clusters;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i)
+  {
+    if (cell_of[i] < 0) continue;
+    int& c = cluster_of_root[root(cell_of[i])];
+    if (c < 0)
+    {
+      c = static_cast<int>(clusters.size());
+      clusters.emplace_back();
+    }
+    clusters[c].push_back(i);
+  }
+  std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
+  for (const std::vector<int>& idx : clusters)
+  {
+    if (static_cast<int>(idx.size()) < p.min_cluster_points) continue;
+    if (background && p.background_share < 1.0)
+    {
+      std::size_t on_background = 0;
+      for (int i : idx) on_background += (*background)[i] != 0;
+      if (static_cast<double>(on_background) > p.background_share * static_cast<double>(idx.size())) continue;
+    }
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (int i : idx) mean += Eigen::Vector2d(points[i].x, points[i].y);
+    mean /= static_cast<double>(idx.size());
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (int i : idx)
+    {
+      const Eigen::Vector2d d = Eigen::Vector2d(points[i].x, points[i].y) - mean;
+      scatter += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
+    const Eigen::Vector2d major = eig.eigenvectors().col(1);
+    const Eigen::Vector2d minor(-major.y(), major.x());
+    double lo_u = 1e300, hi_u = -1e300, lo_v = 1e300, hi_v = -1e300;
+    for (int i : idx)
+    {
+      const Eigen::Vector2d d = Eigen::Vector2d(points[i].x, points[i].y) - mean;
+      lo_u = std::min(lo_u, d.dot(major));
+      hi_u = std::max(hi_u, d.dot(major));
+      lo_v = std::min(lo_v, d.dot(minor));
+      hi_v = std::max(hi_v, d.dot(minor));
+    }
+    Measurement m;
+    m.length = hi_u - lo_u;
+    m.width = hi_v - lo_v;
+    if (m.length > p.max_object_length || m.width > p.max_object_width) continue;
+    m.centroid = Point2{ mean.x(), mean.y() };
+    m.lo_u = lo_u;
+    m.hi_u = hi_u;
+    m.lo_v = lo_v;
+    m.hi_v = hi_v;
+    m.yaw = std::atan2(major.y(), major.x());
+    m.points = static_cast<int>(idx.size());
+    const double su = p.measurement_sigma + p.extent_sigma * m.length;
+    const double sv = p.measurement_sigma + p.extent_sigma * m.width;
+    Eigen::Matrix2d axes;
+    axes << major, minor;
+    m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
+    ordered.emplace_back(*std::min_element(idx.begin(), idx.end()), m);
+  }
+  std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Measurement> out;
+  out.reserve(ordered.size());
+  for (auto& [k, m] : ordered) out.push_back(m);
+  return out;
+}
+
+namespace {
+
+/// The cluster of @p m seen along @p axis: its interval relative to the centroid and whether its low end is the one
+/// nearest the sensor.
+struct AxisView
+{
+  double lo = 0.0, hi = 0.0;
+  bool near_lo = true;
+};
+
+AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis)
+{
+  const Eigen::Vector2d mu(std::cos(m.yaw), std::sin(m.yaw)), mv(-mu.y(), mu.x());
+  AxisView a{ 1e300, -1e300, true };
+  for (double u : { m.lo_u, m.hi_u })
+    for (double v : { m.lo_v, m.hi_v })
+    {
+      const double x = (u * mu + v * mv).dot(axis);
+      a.lo = std::min(a.lo, x);
+      a.hi = std::max(a.hi, x);
+    }
+  const Eigen::Vector2d sensor(m.sensor.x - m.centroid.x, m.sensor.y - m.centroid.y);
+  a.near_lo = sensor.dot(axis) < 0.5 * (a.lo + a.hi);
+  return a;
+}
+
+bool anchored(const Track& t, const Measurement& m)
+{
+  return m.has_sensor && t.extent_length > 0.0 && m.hi_u - m.lo_u > 0.0;
+}
+
+/// Offset of the track's box centre from the centroid along one axis: the middle of the cluster when it is as long as
+/// the box, else the box placed on the cluster's end nearest the sensor.
+double centreAlong(const AxisView& a, double extent)
+{
+  if (std::abs((a.hi - a.lo) - extent) <= kAnchorTolerance) return 0.5 * (a.lo + a.hi);
+  return a.near_lo ? a.lo + 0.5 * extent : a.hi - 0.5 * extent;
+}
+
+}  // namespace
+
+Point2 referencePoint(const Track& t, const Measurement& m)
+{
+  if (!anchored(t, m)) return m.centroid;
+  const Eigen::Vector2d tu(std::cos(t.extent_yaw), std::sin(t.extent_yaw)), tv(-tu.y(), tu.x());
+  const Eigen::Vector2d r = Eigen::Vector2d(m.centroid.x, m.centroid.y) +
+                            centreAlong(viewAlong(m, tu), t.extent_length) * tu +
+                            centreAlong(viewAlong(m, tv), t.extent_width) * tv;
+  return Point2{ r.x(), r.y() };
+}
+
+double Track::speedSigma() const
+{
+  const Eigen::Matrix2d pv = P.bottomRightCorner<2, 2>();
+  const Eigen::Vector2d v = x.tail<2>();
+  const double s = v.norm();
+  if (s < kTinySpeed) return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(pv).eigenvalues()(1)));
+  const Eigen::Vector2d u = v / s;
+  return std::sqrt(std::max(0.0, u.dot(pv * u)));
+}
+
+Tracker::Tracker(const TrackerParams& params) : params_(params) { params_.validate(); }
+
+void Tracker::reset()
+{
+  counts_.tracks_deleted += tracks_.size();
+  tracks_.clear();
+}
+
+void Tracker::predict(Track& t, double dt) const
+{
+  Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
+  f(0, 2) = f(1, 3) = dt;
+  const double q = params_.acceleration_sigma * params_.acceleration_sigma;
+  const double dt2 = dt * dt, dt3 = dt2 * dt, dt4 = dt3 * dt;
+  Eigen::Matrix4d qm = Eigen::Matrix4d::Zero();
+  qm(0, 0) = qm(1, 1) = 0.25 * dt4 * q;
+  qm(0, 2) = qm(2, 0) = qm(1, 3) = qm(3, 1) = 0.5 * dt3 * q;
+  qm(2, 2) = qm(3, 3) = dt2 * q;
+  t.x = f * t.x;
+  t.P = f * t.P * f.transpose() + qm;
+}
+
+void Tracker::correct(Track& t, const Measurement& m, double stamp) const
+{
+  const Eigen::Matrix2d r = measurementCovariance(t, m);
+  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + r;
+  const Eigen::Matrix<double, 4, 2> k = t.P.leftCols<2>() * s.inverse();
+  const Point2 ref = referencePoint(t, m);
+  const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
+  t.x += k * y;
+  Eigen::Matrix<double, 2, 4> h = Eigen::Matrix<double, 2, 4>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  const Eigen::Matrix4d ikh = Eigen::Matrix4d::Identity() - k * h;
+  // Joseph form: stays symmetric and positive semi-definite.
+  t.P = ikh * t.P * ikh.transpose() + k * r * k.transpose();
+  t.yaw = m.yaw;
+  t.length = m.length;
+  t.width = m.width;
+  if (anchored(t, m))
+  {
+    // A longer cluster than the box: the box grows away from the sensor; its centre moves, the object does not.
+    const Eigen::Vector2d tu(std::cos(t.extent_yaw), std::sin(t.extent_yaw)), tv(-tu.y(), tu.x());
+    for (auto [axis, extent] : { std::pair<Eigen::Vector2d, double*>{ tu, &t.extent_length },
+                                 std::pair<Eigen::Vector2d, double*>{ tv, &t.extent_width } })
+    {
+      const AxisView a = viewAlong(m, axis);
+      const double grown = (a.hi - a.lo) - *extent;
+      if (grown <= kAnchorTolerance) continue;
+      t.x.head<2>() += (a.near_lo ? 0.5 : -0.5) * grown * axis;
+      *extent = a.hi - a.lo;
+    }
+  }
+  else
+  {
+    t.extent_length = std::max(t.extent_length, m.length);
+    t.extent_width = std::max(t.extent_width, m.width);
+  }
+  ++t.hits;
+  ++t.consecutive_hits;
+  t.last_hit = stamp;
+  if (t.state == TrackState::kCoasting || (t.state == TrackState::kTentative && t.consecutive_hits >= params_.confirm_hits))
+    t.state = TrackState::kConfirmed;
+}
+
+void Tracker::decideMotion(Track& t, double stamp) const
+{
+  if (t.state == TrackState::kTentative)
+  {
+    t.motion = TrackMotion::kUnknown;
+    return;
+  }
+  const double s = t.speed(), sigma = t.speedSigma();
+  if (s + params_.motion_sigmas * sigma < params_.stopped_speed)
+  {
+    if (t.still_since < 0.0) t.still_since = stamp;
+  }
+  else
+    t.still_since = -1.0;
+  if (s - params_.motion_sigmas * sigma > params_.moving_speed)
+    t.motion = TrackMotion::kMoving;
+  else if (t.still_since >= 0.0 && stamp - t.still_since >= params_.stopped_time - kMinStep)
+    t.motion = TrackMotion::kStopped;
+  else
+    t.motion = TrackMotion::kUnknown;
+}
+
+void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& returns,
+                     const std::vector<std::uint8_t>* background)
+{
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw) || !std::isfinite(stamp))
+  {
+    ++counts_.non_finite_inputs;
+    return;
+  }
+  if (last_stamp_ >= 0.0)
+  {
+    const double dt = stamp - last_stamp_;
+    const double moved = std::hypot(pose.x - last_pose_.x, pose.y - last_pose_.y);
+    if (dt > kMinStep && moved / dt > params_.max_ego_speed && !tracks_.empty())
+    {
+      reset();
+      ++counts_.resets;
+    }
+  }
+  last_pose_ = pose;
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  map_points_.clear();
+  map_points_.reserve(returns.count);
+  map_flags_.clear();
+  const bool flagged = background && background->size() == returns.count;
+  for (std::size_t i = 0; i < returns.count; ++i)
+  {
+    const double x = returns.xy[2 * i], y = returns.xy[2 * i + 1];
+    if (!std::isfinite(x) || !std::isfinite(y))
+    {
+      ++counts_.non_finite_inputs;
+      continue;
+    }
+    map_points_.push_back(Point2{ pose.x + c * x - s * y, pose.y + s * x + c * y });
+    if (flagged) map_flags_.push_back((*background)[i]);
+  }
+  std::vector<Measurement> found = clusterReturns(map_points_, params_, flagged ? &map_flags_ : nullptr);
+  for (Measurement& m : found)
+  {
+    m.has_sensor = true;
+    m.sensor = Point2{ pose.x, pose.y };
+  }
+  update(stamp, found);
+}
+
+void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
+{
+  ++counts_.scans;
+  if (!std::isfinite(stamp))
+  {
+    ++counts_.non_finite_inputs;
+    return;
+  }
+  if (last_stamp_ >= 0.0 && stamp <= last_stamp_)
+  {
+    if (!tracks_.empty())
+    {
+      reset();
+      ++counts_.resets;
+    }
+  }
+  const double dt = last_stamp_ >= 0.0 && stamp > last_stamp_ ? stamp - last_stamp_ : 0.0;
+  last_stamp_ = stamp;
+  measurements_.clear();
+  for (const Measurement& m : measurements)
+  {
+    if (std::isfinite(m.centroid.x) && std::isfinite(m.centroid.y) && m.covariance.allFinite() &&
+        m.covariance.determinant() > 0.0)
+      measurements_.push_back(m);
+    else
+      ++counts_.non_finite_inputs;
+  }
+  counts_.measurements += measurements_.size();
+  for (Track& t : tracks_) predict(t, dt);
+
+  // Gated global assignment on the Mahalanobis distance of the innovation.
+  CostMatrix cost(static_cast<int>(tracks_.size()), static_cast<int>(measurements_.size()));
+  // Only measurements whose centroid is within reach in x: the followed point is at most half a box from it.
+  std::vector<int> by_x(measurements_.size());
+  for (std::size_t m = 0; m < by_x.size(); ++m) by_x[m] = static_cast<int>(m);
+  std::sort(by_x.begin(), by_x.end(),
+            [&](int a, int b) { return measurements_[a].centroid.x < measurements_[b].centroid.x; });
+  const double reach = params_.max_gate_distance + 0.5 * std::hypot(params_.max_object_length, params_.max_object_width);
+  for (int r = 0; r < cost.rows; ++r)
+  {
+    const Track& t = tracks_[r];
+    auto first = std::lower_bound(by_x.begin(), by_x.end(), t.x(0) - reach,
+                                  [&](int a, double x) { return measurements_[a].centroid.x < x; });
+    for (auto it = first; it != by_x.end() && measurements_[*it].centroid.x <= t.x(0) + reach; ++it)
+    {
+      const int m = *it;
+      const Measurement& z = measurements_[m];
+      const Point2 ref = referencePoint(t, z);
+      const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
+      if (y.norm() > params_.max_gate_distance) continue;
+      const Eigen::Matrix2d sm = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z);
+      const double d2 = y.dot(sm.ldlt().solve(y));
+      if (std::isfinite(d2) && d2 <= params_.gate) cost.at(r, m) = d2;
+    }
+  }
+  const std::vector<int> pairs = solveAssignment(cost);
+  std::vector<char> used(measurements_.size(), 0);
+  for (int r = 0; r < cost.rows; ++r)
+  {
+    Track& t = tracks_[r];
+    if (pairs[r] >= 0)
+    {
+      correct(t, measurements_[pairs[r]], stamp);
+      used[pairs[r]] = 1;
+    }
+    else
+    {
+      t.consecutive_hits = 0;
+      if (t.state == TrackState::kConfirmed) t.state = TrackState::kCoasting;
+    }
+  }
+  // Lifecycle: a tentative track missed once, a coasting track too long unseen, a broken state.
+  std::vector<Track> kept;
+  kept.reserve(tracks_.size() + measurements_.size());
+  for (Track& t : tracks_)
+  {
+    const bool missed = t.last_hit < stamp;
+    if (!finite(t.x, t.P) || t.speed() > params_.max_speed)
+    {
+      ++counts_.rejected_tracks;
+      ++counts_.tracks_deleted;
+      continue;
+    }
+    if ((t.state == TrackState::kTentative && missed) ||
+        (t.state == TrackState::kCoasting && stamp - t.last_hit > params_.max_coast_time))
+    {
+      ++counts_.tracks_deleted;
+      continue;
+    }
+    decideMotion(t, stamp);
+    kept.push_back(t);
+  }
+  const double v2 = params_.initial_speed_sigma * params_.initial_speed_sigma;
+  for (std::size_t m = 0; m < measurements_.size(); ++m)
+  {
+    if (used[m]) continue;
+    const Measurement& z = measurements_[m];
+    Track t;
+    t.id = next_id_++;
+    // The middle of the cluster's box, the point referencePoint() follows.
+    const double mu = 0.5 * (z.lo_u + z.hi_u), mv = 0.5 * (z.lo_v + z.hi_v);
+    const double cu = std::cos(z.yaw), su = std::sin(z.yaw);
+    t.x << z.centroid.x + mu * cu - mv * su, z.centroid.y + mu * su + mv * cu, 0.0, 0.0;
+    t.P.setZero();
+    t.P.topLeftCorner<2, 2>() = z.covariance;
+    t.P(2, 2) = t.P(3, 3) = v2;
+    t.yaw = t.extent_yaw = z.yaw;
+    t.length = t.extent_length = z.length;
+    t.width = t.extent_width = z.width;
+    t.hits = t.consecutive_hits = 1;
+    t.first_stamp = t.last_hit = stamp;
+    if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
+    decideMotion(t, stamp);
+    kept.push_back(t);
+    ++counts_.tracks_created;
+  }
+  tracks_ = std::move(kept);
+}
+
+}  // namespace core
+}  // namespace map_aided_fusion
