@@ -774,5 +774,49 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   return stats;
 }
 
+void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
+{
+  if (cells.empty()) return;
+  float* const base = grid_.planes();
+  std::vector<std::size_t> changed;
+  changed.reserve(cells.size());
+  const std::size_t n = grid_.numCells();
+  for (const CellMotion& c : cells)
+  {
+    if (c.cell >= n) continue;
+    changed.push_back(c.cell);
+    if (c.motion != CellClass::kMoving && c.motion != CellClass::kStopped) continue;
+    const float beta = std::clamp(c.weight, 0.0f, 1.0f);
+    if (!(beta > 0.0f)) continue;
+    const unsigned target = c.motion == CellClass::kMoving ? FrameMG::kV : FrameMG::kS;
+    const unsigned other = c.motion == CellClass::kMoving ? FrameMG::kS : FrameMG::kV;
+    // Only sets within {F, S, V}: the static classes stay the prior's and the counter's (a false moving track on a
+    // pole must not take its N).
+    const unsigned dynamic = FrameMG::kF | FrameMG::kS | FrameMG::kV;
+    const unsigned agreeing = FrameMG::kF | other;  // sets within {F, other} go to the target
+    float mass[kernels::kSubsets];
+    kernels::loadMasses(base, c.cell, mass);
+    float to_target = 0.0f;
+    for (unsigned a = 1; a < static_cast<unsigned>(kernels::kSubsets); ++a)
+    {
+      if (a == target || mass[a] == 0.0f || (a & ~dynamic) != 0 || !((a & target) || (a & ~agreeing) == 0)) continue;
+      const float moved = beta * mass[a];
+      mass[a] -= moved;
+      to_target += moved;
+    }
+    mass[target] += to_target;
+    kernels::renormalise(mass);
+    kernels::storeMasses(base, c.cell, mass);
+    float p[FrameMG::kSize];
+    kernels::pignistic(mass, p);
+    for (int e = 0; e < FrameMG::kSize; ++e) betp_.p[e][c.cell] = p[e];
+  }
+  redecide(grid_, betp_, params_, changed, decision_);
+  const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
+  for (const CellMotion& c : cells)
+    if (c.motion == CellClass::kOccupied && c.cell < n && (decision_[c.cell] == stopped || decision_[c.cell] == moving))
+      decision_[c.cell] = static_cast<std::int8_t>(CellClass::kOccupied);
+}
+
 }  // namespace core
 }  // namespace map_aided_fusion

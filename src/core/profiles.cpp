@@ -39,6 +39,9 @@ const std::vector<AddedStep>& addedSteps()
     { "motion_margin", "S or V within motion_margin of each other is decided 'occupied, motion not yet known'",
       [](const Profile& p) { return p.map_grid.motion_margin > 0.0; },
       [](Profile& p) { p.map_grid.motion_margin = 0.0; } },
+    { "track_evidence", "a moving track supports {V} in its cells, a stopped one {S}; one not yet known makes them neither",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_weight > 0.0; },
+      [](Profile& p) { p.tracker.evidence_weight = 0.0; } },
   };
   return steps;
 }

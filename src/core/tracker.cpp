@@ -58,6 +58,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_stopped_time", stopped_time, 0.0, 600.0);
   requirePositive("tracker_max_speed", max_speed);
   requirePositive("tracker_max_ego_speed", max_ego_speed);
+  requireUnit("tracker_evidence_weight", evidence_weight);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -184,6 +185,7 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     m.hi_v = hi_v;
     m.yaw = std::atan2(major.y(), major.x());
     m.points = static_cast<int>(idx.size());
+    m.returns = idx;
     const double su = p.measurement_sigma + p.extent_sigma * m.length;
     const double sv = p.measurement_sigma + p.extent_sigma * m.width;
     Eigen::Matrix2d axes;
@@ -386,12 +388,14 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
     m.has_sensor = true;
     m.sensor = Point2{ pose.x, pose.y };
   }
-  update(stamp, found);
+  own_measurements_ = std::move(found);
+  update(stamp, own_measurements_);
 }
 
 void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
 {
   ++counts_.scans;
+  if (&measurements != &own_measurements_) map_points_.clear();
   if (!std::isfinite(stamp))
   {
     ++counts_.non_finite_inputs;
@@ -417,7 +421,11 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       ++counts_.non_finite_inputs;
   }
   counts_.measurements += measurements_.size();
-  for (Track& t : tracks_) predict(t, dt);
+  for (Track& t : tracks_)
+  {
+    predict(t, dt);
+    t.measurement = -1;
+  }
 
   // Gated global assignment on the Mahalanobis distance of the innovation.
   CostMatrix cost(static_cast<int>(tracks_.size()), static_cast<int>(measurements_.size()));
@@ -453,6 +461,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     {
       correct(t, measurements_[pairs[r]], stamp);
       used[pairs[r]] = 1;
+      t.measurement = pairs[r];
     }
     else
     {
@@ -500,6 +509,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     t.width = t.extent_width = z.width;
     t.hits = t.consecutive_hits = 1;
     t.first_stamp = t.last_hit = stamp;
+    t.measurement = static_cast<int>(m);
     if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
     decideMotion(t, stamp);
     kept.push_back(t);

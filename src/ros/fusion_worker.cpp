@@ -12,6 +12,7 @@
 
 #include "map_aided_fusion/ros/conversions.hpp"
 #include "map_aided_fusion/ros/param_loading.hpp"
+#include "map_aided_fusion/core/track_evidence.hpp"
 #include "map_aided_fusion/ros/visualization.hpp"
 
 namespace map_aided_fusion {
@@ -492,8 +493,8 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   std_msgs::Header header;
   header.stamp = msg->header.stamp;
   header.frame_id = node_params_.map_frame;
-  publish(header, prior);
   if (tracker_) track(header, stamp, pose, obstacles);
+  publish(header, prior);
   last_total_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 
@@ -562,6 +563,7 @@ void FusionWorker::track(const std_msgs::Header& header, double stamp, const cor
                         },
                         background_);
   tracker_->update(stamp, pose, returns, &background_);
+  grid_.applyTrackedMotion(core::trackEvidence(*tracker_, g));
   if (tracker_->counts().resets > tracker_resets_seen_)
   {
     tracker_resets_seen_ = tracker_->counts().resets;

@@ -37,6 +37,7 @@
 #include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
+#include "map_aided_fusion/core/track_evidence.hpp"
 #include "map_aided_fusion/eval/metrics.hpp"
 #include "map_aided_fusion/eval/movers.hpp"
 #include "map_aided_fusion/eval/point_labels.hpp"
@@ -732,6 +733,7 @@ int main(int argc, char** argv)
                                 },
                                 v->background);
           v->tracker->update(t, pose, obstacles, &v->background);
+          v->grid.applyTrackedMotion(core::trackEvidence(*v->tracker, g));
         }
         auto scoreTracks = [&](const std::vector<eval::ObjectSighting>& sightings) {
           if (!v->tracker || !objects || point_mode) return;

@@ -2,6 +2,7 @@
 // answer, each run with the default profile and with the paper's profile.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -327,5 +328,77 @@ TEST(MotionSteps, PaperProfileHasEveryAddedStepOffAndDefaultHasThemOn)
 }
 
 }  // namespace
+}  // namespace core
+}  // namespace map_aided_fusion
+
+namespace map_aided_fusion {
+namespace core {
+namespace {
+
+/// Every stored focal set's mass of one cell.
+std::vector<float> massesOf(const MapGrid& g, std::size_t i)
+{
+  std::vector<float> m(FrameMG::kNumSubsets, 0.0f);
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+    if (MapMassGrid::stored(a)) m[a] = g.masses().at(a, i);
+  return m;
+}
+
+}  // namespace
+
+// Step "track evidence": the transfer to {V} of β·m(A) for every A ⊆ {F, S, V}, by its definition, on the cell of a
+// car seen for a few scans on a road; the sets holding C or N untouched; still a mass function; decisions again.
+TEST(MotionSteps, TrackEvidenceMovesTheDynamicMassesToTheTrackedMotion)
+{
+  World world;
+  world.boxes.push_back({ 10.0, -1.0, 14.0, 1.0, 1.5 });  // a car 10 m ahead, on a road (prior {F, S, V})
+  core::Run run(defaultProfile());  // qualified: Run alone is gtest's Test::Run
+  const GridGeometry& g = run.grid.geometry();
+  PriorWindow road;
+  road.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
+  std::fill(road.road.begin(), road.road.end(), 0.85f);
+  for (int k = 0; k < 4; ++k) run.step(world, Pose2{ 0.0, 0.0, 0.0 }, &road);
+  CellIndex ci;
+  ASSERT_TRUE(g.worldToCell(Point2{ 10.1, 0.1 }, ci));
+  const std::size_t i = g.index(ci);
+  ASSERT_TRUE(g.worldToCell(Point2{ 30.0, 20.0 }, ci));
+  const std::size_t far = g.index(ci);
+  const std::vector<float> before = massesOf(run.grid, i), far_before = massesOf(run.grid, far);
+  // Moving: the sets within {F, S, V} that hold V or lie within {F, S}.
+  auto gives = [](Subset a) {
+    return a != FrameMG::kV && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0;
+  };
+  double moved = 0.0;
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+    if (gives(a)) moved += 0.5 * before[a];
+  ASSERT_GT(moved, 0.0) << "the car's cell holds dynamic mass";
+  run.grid.applyTrackedMotion({ CellMotion{ i, CellClass::kMoving, 0.5f } });
+  const std::vector<float> after = massesOf(run.grid, i);
+  double total = 0.0;
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+  {
+    EXPECT_GE(after[a], 0.0f);
+    total += after[a];
+    if (a == FrameMG::kV)
+      EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
+    else if (gives(a))
+      EXPECT_NEAR(after[a], 0.5 * before[a], 1e-6) << subsetName<FrameMG>(a);
+    else
+      EXPECT_NEAR(after[a], before[a], 1e-6) << subsetName<FrameMG>(a) << " holds C or N: untouched";
+  }
+  EXPECT_NEAR(total, 1.0, 1e-5);
+  EXPECT_EQ(massesOf(run.grid, far), far_before);
+  // BetP and the decision follow the new masses.
+  std::vector<std::int8_t> d;
+  decide(run.grid.masses(), run.grid.pignistic(), run.grid.params(), d);
+  EXPECT_EQ(run.grid.decisions(), d);
+  EXPECT_EQ(d[i], static_cast<std::int8_t>(CellClass::kMoving));
+  // A track whose motion is not known yet: a cell decided S or V becomes 5, its masses unchanged.
+  const std::vector<float> kept = massesOf(run.grid, i);
+  run.grid.applyTrackedMotion({ CellMotion{ i, CellClass::kOccupied, 0.0f } });
+  EXPECT_EQ(run.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kOccupied));
+  EXPECT_EQ(massesOf(run.grid, i), kept);
+}
+
 }  // namespace core
 }  // namespace map_aided_fusion

@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/core/track_evidence.hpp"
 #include "map_aided_fusion/core/tracker.hpp"
 
 using namespace map_aided_fusion::core;
@@ -290,4 +292,50 @@ TEST(Tracker, ClustersMostlyOnStaticBackgroundAreNoCandidates)
   p.background_share = 1.0;  // off
   EXPECT_EQ(clusterReturns(pts, p, &bg).size(), 2u);
   EXPECT_EQ(clusterReturns(pts, TrackerParams{ p }, nullptr).size(), 2u);
+}
+
+TEST(Tracker, EvidenceCoversTheCellsOfTheLastClusterWithTheMotionProbability)
+{
+  Tracker tracker;
+  const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
+  std::vector<float> xy;
+  for (int k = 0; k <= 8; ++k)
+  {
+    // A 4 x 2 m car driving at 8 m/s along x, seen from the origin (vehicle frame = map frame).
+    xy.clear();
+    for (const Point2& p : boxOutline(10.0 + 0.8 * k, 5.0, 0.0, 4.0, 2.0))
+    {
+      xy.push_back(static_cast<float>(p.x));
+      xy.push_back(static_cast<float>(p.y));
+    }
+    tracker.update(0.1 * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  }
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  const Track& t = tracker.tracks()[0];
+  ASSERT_EQ(t.motion, TrackMotion::kMoving);
+  const double p = motionProbability(t, tracker.params());
+  EXPECT_NEAR(p, 0.5 * std::erfc(-(t.speed() - tracker.params().moving_speed) / t.speedSigma() / std::sqrt(2.0)), 1e-12);
+  EXPECT_GT(p, 0.9);
+  const std::vector<CellMotion> cells = trackEvidence(tracker, g);
+  std::set<std::size_t> expected;
+  for (std::size_t i = 0; i < xy.size(); i += 2)
+  {
+    CellIndex c;
+    ASSERT_TRUE(g.worldToCell(Point2{ xy[i], xy[i + 1] }, c));
+    expected.insert(g.index(c));
+  }
+  std::set<std::size_t> got;
+  for (const CellMotion& c : cells)
+  {
+    got.insert(c.cell);
+    EXPECT_EQ(c.motion, CellClass::kMoving);
+    EXPECT_NEAR(c.weight, 0.8 * p, 1e-6);
+  }
+  EXPECT_EQ(got, expected);
+  EXPECT_EQ(got.size(), cells.size()) << "one entry per cell";
+  TrackerParams off;
+  off.evidence_weight = 0.0;
+  Tracker silent(off);
+  silent.update(0.0, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  EXPECT_TRUE(trackEvidence(silent, g).empty());
 }

@@ -153,6 +153,14 @@ struct StageTimes
   double fusion = 0.0;        ///< the fused step (with the scan's samples, BetP, decisions), then motion spreading
 };
 
+/// The motion a tracked object gives one cell (step "track evidence", core/track_evidence.hpp).
+struct CellMotion
+{
+  std::size_t cell = 0;
+  CellClass motion = CellClass::kMoving;  ///< kMoving, kStopped, or kOccupied (occupied, motion not yet known)
+  float weight = 0.0f;                    ///< β in [0, 1] (kMoving, kStopped)
+};
+
 /// An object made of a connected region of moving or stopped cells.
 struct GridObject
 {
@@ -286,6 +294,18 @@ public:
   const GridGeometry& geometry() const { return grid_.geometry(); }
   /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
   const PignisticPlanes& pignistic() const { return betp_; }
+
+  /**
+   * @brief Step "track evidence" (not in the paper): the motion of tracked objects in their cells, after update().
+   *
+   * kMoving with weight β moves β·m(A) to {V} from every focal set A ⊆ {F, S, V} of the cell with V ∈ A or
+   * A ⊆ {F, S} (a mover where space was free or an object stopped, as the paper's ⊛ sends the free-to-occupied
+   * conflict to V); kStopped likewise to {S} (S ∈ A or A ⊆ {F, V}). Sets holding C or N are left alone: the static
+   * classes stay the prior's and the counter's (measured: moving evidence on them lets false moving tracks on poles
+   * and trees take N). Each transfer keeps the total: the result is a mass function. BetP and decisions of the listed cells are computed again; a kOccupied cell decided S or V is
+   * then decided CellClass::kOccupied (an object whose motion is not yet known is neither).
+   */
+  void applyTrackedMotion(const std::vector<CellMotion>& cells);
   /// The decision of every cell after the last update (decide() with these parameters, written in the fusion pass
   /// and again where motion spreading changed a cell); the same as decide(masses(), pignistic(), params()).
   const std::vector<std::int8_t>& decisions() const { return decision_; }

@@ -49,6 +49,9 @@ struct TrackerParams
   double stopped_time = 1.0;         ///< s … for this long
   double max_speed = 50.0;           ///< m/s: a track estimated faster is deleted (a wrong association)
   double max_ego_speed = 70.0;       ///< m/s: a vehicle pose moving faster between two scans resets every track
+  /// Step "track evidence" (core/track_evidence.hpp): the weight w of a track's motion in its cells' masses,
+  /// β = w · P(motion); 0: off.
+  double evidence_weight = 0.8;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -79,6 +82,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_stopped_time", p.stopped_time);
   get("tracker_max_speed", p.max_speed);
   get("tracker_max_ego_speed", p.max_ego_speed);
+  get("tracker_evidence_weight", p.evidence_weight);
 }
 
 /**
@@ -111,6 +115,7 @@ struct Measurement
   int points = 0;
   bool has_sensor = false;  ///< the sensor position is known (the end of a partly seen object nearest it is real)
   Point2 sensor;            ///< map frame
+  std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
 };
 
 /**
@@ -150,6 +155,7 @@ struct Track
   /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
   double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;
   int hits = 0;                                 ///< associations
+  int measurement = -1;                         ///< its measurement of the last scan (Tracker::measurements()), or −1
   int consecutive_hits = 0;
   double first_stamp = 0.0;
   double last_hit = 0.0;                        ///< stamp of the last association
@@ -205,6 +211,8 @@ public:
 
   const std::vector<Track>& tracks() const { return tracks_; }
   const std::vector<Measurement>& measurements() const { return measurements_; }
+  /// The returns of the last scan in the map frame (what Measurement::returns index; empty after update(measurements)).
+  const std::vector<Point2>& points() const { return map_points_; }
   const TrackerCounts& counts() const { return counts_; }
   const TrackerParams& params() const { return params_; }
   /// Drops every track (ids keep counting up).
@@ -218,6 +226,7 @@ private:
   TrackerParams params_;
   std::vector<Track> tracks_;
   std::vector<Measurement> measurements_;
+  std::vector<Measurement> own_measurements_;  ///< the last scan's clusters (update(stamp, pose, returns))
   std::vector<Point2> map_points_;
   std::vector<std::uint8_t> map_flags_;
   TrackerCounts counts_;

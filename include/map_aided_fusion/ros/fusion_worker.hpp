@@ -106,7 +106,8 @@ private:
   void onReconfigure(FusionConfig& config, uint32_t level);
   /// Publishes the layers of the last update, whose prior was @p prior (nullptr: none).
   void publish(const std_msgs::Header& header, const core::PriorWindow* prior);
-  /// Updates the tracker with the scan's obstacle returns and publishes `tracks` and `tracks/markers`.
+  /// Updates the tracker with the scan's obstacle returns, applies its motion evidence to the MapGrid (step "track
+  /// evidence") and publishes `tracks` and `tracks/markers`.
   void track(const std_msgs::Header& header, double stamp, const core::Pose2& pose, const core::ObstaclePoints& returns);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 

@@ -1,0 +1,33 @@
+/**
+ * @file track_evidence.hpp
+ * @brief Step "track evidence" (not in the paper): what the tracked objects say of the MapGrid's cells. A
+ *        confidently moving track supports {V} in the cells holding its returns of the last scan, a confidently
+ *        stopped one {S}, with weight β = tracker_evidence_weight · P(motion); a track whose motion is not yet known
+ *        makes its cells neither S nor V (MapGrid::applyTrackedMotion()).
+ *
+ * P(moving) = Φ((speed − tracker_moving_speed) / σ(speed)), P(stopped) = Φ((tracker_stopped_speed − speed) /
+ * σ(speed)), Φ the standard normal distribution function: how sure the track's velocity makes the motion.
+ */
+#pragma once
+
+#include <vector>
+
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/tracker.hpp"
+
+namespace map_aided_fusion {
+namespace core {
+
+/// The probability, from the track's speed and its σ, that it moves faster than moving_speed (moving) or slower
+/// than stopped_speed (stopped); 0 for a track whose motion is not decided.
+double motionProbability(const Track& track, const TrackerParams& params);
+
+/**
+ * @brief The cells of @p geometry holding the returns of the last scan of every reported track associated in that
+ *        scan, with the track's motion and β. Empty when evidence_weight is 0 or the tracker was given measurements
+ *        without returns.
+ */
+std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry& geometry);
+
+}  // namespace core
+}  // namespace map_aided_fusion
