@@ -102,6 +102,7 @@ const char* toString(CovarianceFault f)
     case CovarianceFault::kNonFinite: return "a non-finite entry";
     case CovarianceFault::kNegativeVariance: return "a negative variance";
     case CovarianceFault::kAsymmetric: return "an asymmetric matrix";
+    case CovarianceFault::kIndefinite: return "an indefinite x-y block (a negative eigenvalue)";
     case CovarianceFault::kNone: break;
   }
   return "none";
@@ -122,6 +123,7 @@ CovarianceFault positionSigma(const std::array<double, 36>& c, double& sigma)
         return CovarianceFault::kAsymmetric;
     }
   const double xx = c[0], yy = c[7], xy = 0.5 * (c[1] + c[6]);
+  if (xx * yy - xy * xy < -kSymmetryTolerance * std::max(1.0, xx * yy)) return CovarianceFault::kIndefinite;
   const double mean = 0.5 * (xx + yy), dev = std::sqrt(0.25 * (xx - yy) * (xx - yy) + xy * xy);
   sigma = std::sqrt(std::max(0.0, mean + dev));
   return CovarianceFault::kNone;

@@ -1,6 +1,8 @@
 // PriorGridParams validation and the published window (cap on the message size).
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <string>
@@ -202,6 +204,17 @@ TEST(Profiles, ConfigFilesHoldTheDefaultAndThePaperProfiles)
   {
     if (options.count(kv.first.as<std::string>())) continue;
     EXPECT_EQ(YAML::Dump(kv.second), YAML::Dump(b[kv.first.as<std::string>()])) << kv.first;
+  }
+}
+
+TEST(Profiles, FusionFilesStateTheBytesPerCellTheCodeUses)
+{
+  const std::string want = "(" + std::to_string(core::MapGridParams::bytesPerCell()) + " bytes per cell)";
+  for (const char* f : { "fusion.yaml", "paper/fusion.yaml", "learned/fusion.yaml" })
+  {
+    std::ifstream in(std::string(MAF_PACKAGE_DIR) + "/config/" + f);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find(want), std::string::npos) << f << " does not say " << want;
   }
 }
 

@@ -219,6 +219,14 @@ TEST(PoseCovariance, SigmaIsTheLargestStandardDeviationOfThePositionAndFaultsAre
   bad = c;
   bad[1] = 0.5;
   EXPECT_EQ(positionSigma(bad, sigma), CovarianceFault::kAsymmetric);
+  // [[1, 5], [5, 1]]: symmetric, positive diagonal, eigenvalues 6 and -4: no covariance (it read as sigma 2.45 m).
+  bad = c;
+  bad[0] = bad[7] = 1.0;
+  bad[1] = bad[6] = 5.0;
+  sigma = 7.0;
+  EXPECT_EQ(positionSigma(bad, sigma), CovarianceFault::kIndefinite);
+  EXPECT_EQ(sigma, 7.0);
+  EXPECT_NE(std::string(toString(CovarianceFault::kIndefinite)).find("indefinite"), std::string::npos);
 }
 
 TEST(Navigable, FreeRoadIsZeroFreeElsewhereIsOffRoadOccupiedIsHundred)

@@ -32,6 +32,7 @@ enum class CovarianceFault
   kNonFinite,         ///< a NaN or infinite entry
   kNegativeVariance,  ///< a negative diagonal entry
   kAsymmetric,        ///< C(i, j) ≠ C(j, i) beyond a relative 1e-6
+  kIndefinite,        ///< the x-y block has a negative eigenvalue (its determinant < 0): no covariance
 };
 
 /// Short text of a fault, for warnings.
