@@ -60,5 +60,20 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
   return out;
 }
 
+void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
+               std::vector<std::uint8_t>& background)
+{
+  const GridGeometry& g = grid.geometry();
+  const MapMassGrid& masses = grid.masses();
+  backgroundFlags(pose, returns, tracker.params().background_zeta,
+                  [&](Point2 p) {
+                    CellIndex c;
+                    return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
+                  },
+                  background);
+  tracker.update(stamp, pose, returns, &background);
+  grid.applyTrackedMotion(trackEvidence(tracker, g));
+}
+
 }  // namespace core
 }  // namespace map_aided_fusion

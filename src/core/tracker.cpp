@@ -8,6 +8,7 @@
 
 #include "map_aided_fusion/core/assignment.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/core/stamp_guard.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -355,15 +356,11 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
     ++counts_.non_finite_inputs;
     return;
   }
-  if (last_stamp_ >= 0.0)
+  if (last_stamp_ >= 0.0 && stamp - last_stamp_ > kMinStep && !tracks_.empty() &&
+      checkPoseJump(last_pose_.x, last_pose_.y, last_stamp_, pose.x, pose.y, stamp, params_.max_ego_speed).jumped)
   {
-    const double dt = stamp - last_stamp_;
-    const double moved = std::hypot(pose.x - last_pose_.x, pose.y - last_pose_.y);
-    if (dt > kMinStep && moved / dt > params_.max_ego_speed && !tracks_.empty())
-    {
-      reset();
-      ++counts_.resets;
-    }
+    reset();
+    ++counts_.resets;
   }
   last_pose_ = pose;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);

@@ -554,16 +554,7 @@ void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWind
 void FusionWorker::track(const std_msgs::Header& header, double stamp, const core::Pose2& pose,
                           const core::ObstaclePoints& returns)
 {
-  const core::GridGeometry& g = grid_.geometry();
-  const core::MapMassGrid& masses = grid_.masses();
-  core::backgroundFlags(pose, returns, tracker_->params().background_zeta,
-                        [&](core::Point2 p) {
-                          core::CellIndex c;
-                          return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
-                        },
-                        background_);
-  tracker_->update(stamp, pose, returns, &background_);
-  grid_.applyTrackedMotion(core::trackEvidence(*tracker_, g));
+  core::trackScan(*tracker_, grid_, stamp, pose, returns, background_);
   if (tracker_->counts().resets > tracker_resets_seen_)
   {
     tracker_resets_seen_ = tracker_->counts().resets;

@@ -722,30 +722,17 @@ int main(int argc, char** argv)
         if (auto c = covariance_sigma.upper_bound(k); c != covariance_sigma.begin()) sigma = std::prev(c)->second;
         const core::PriorWindow* pw = v->use_prior ? v->softener.softened(sigma) : nullptr;
         v->grid.update(v->scan, pose, t, pw, nullptr, &obstacles);
-        if (v->tracker)
-        {
-          const auto& g = v->grid.geometry();
-          const auto& masses = v->grid.masses();
-          core::backgroundFlags(pose, obstacles, v->tracker->params().background_zeta,
-                                [&](core::Point2 p) {
-                                  core::CellIndex c;
-                                  return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
-                                },
-                                v->background);
-          v->tracker->update(t, pose, obstacles, &v->background);
-          v->grid.applyTrackedMotion(core::trackEvidence(*v->tracker, g));
-        }
+        if (v->tracker) core::trackScan(*v->tracker, v->grid, t, pose, obstacles, v->background);
         auto scoreTracks = [&](const std::vector<eval::ObjectSighting>& sightings) {
           if (!v->tracker || !objects || point_mode) return;
-          {
-            // Labelled boxes: only tracks where the labels are valid can be judged.
-            const eval::ClassGrid* valid = object_mode ? nearest(valid_masks, cloud->header.stamp) : nullptr;
-            std::vector<eval::MotHypothesis> hypotheses;
-            for (const core::Track& tr : v->tracker->tracks())
-              if (tr.reported() && tr.motion == core::TrackMotion::kMoving && (!object_mode || (valid && valid->at(tr.position()) > 0)))
-                hypotheses.push_back(eval::MotHypothesis{ tr.id, tr.position(), true, tr.velocity() });
-            v->scores.tracks.addFrame(eval::motObjects(*objects, sightings, v->scores.movers), hypotheses);
-          }
+          // Labelled boxes: only tracks where the labels are valid can be judged.
+          const eval::ClassGrid* valid = object_mode ? nearest(valid_masks, cloud->header.stamp) : nullptr;
+          std::vector<eval::MotHypothesis> hypotheses;
+          for (const core::Track& tr : v->tracker->tracks())
+            if (tr.reported() && tr.motion == core::TrackMotion::kMoving &&
+                (!object_mode || (valid && valid->at(tr.position()) > 0)))
+              hypotheses.push_back(eval::MotHypothesis{ tr.id, tr.position(), true, tr.velocity() });
+          v->scores.tracks.addFrame(eval::motObjects(*objects, sightings, v->scores.movers), hypotheses);
         };
         v->last_prior = pw;
         v->decision.geometry = v->grid.geometry();
