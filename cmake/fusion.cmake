@@ -32,6 +32,7 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_definitions(test_faults PRIVATE MAF_FUSION_NODE="$<TARGET_FILE:fusion_node>")
   add_dependencies(test_faults fusion_node map_aided_fusion_fusion_nodelet)
   add_rostest(test/bag_loop.test DEPENDENCIES test_faults)
+  add_rostest(test/clock_lag.test DEPENDENCIES test_faults)
 endif()
 
 if(TARGET bench_map_aided_fusion)

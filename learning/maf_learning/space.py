@@ -75,6 +75,9 @@ def load_space(path, config_dir=None):
     for file, entries in data.items():
         if file not in CONFIG_FILES:
             raise SpaceError(f"search space: '{file}' is not a configuration file ({', '.join(CONFIG_FILES)})")
+        if entries is not None and not isinstance(entries, dict):
+            raise SpaceError(f"search space: {file}: must map parameters to ranges ({{name: [lo, hi]}}), "
+                             f"not {entries!r}")
         keys = config_keys(os.path.join(config_dir, file))
         for name, spec in (entries or {}).items():
             where = f"search space: {file}: {name}"

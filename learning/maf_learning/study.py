@@ -170,6 +170,7 @@ def create_or_load(setup, log=print):
         base = sp.base_values(setup.config)
         study.enqueue_trial({p.key: base[p.file][p.name] for p in setup.params}, user_attrs={"seeded": "config/"})
     if "reference" not in study.user_attrs:
+        setup.prepare(setup.training, log)
         study.set_user_attr("reference", reference_scores(setup, log))
     return study, storage
 
@@ -258,8 +259,8 @@ def _progress_line(trials, target, started, done_before):
 def tune(setup, log=print):
     """Runs the study to --trials counted trials with --jobs worker processes; returns the exit code."""
     a = setup.args
+    study, storage = create_or_load(setup, log)  # the storage is reached before any drive is simulated
     setup.prepare(setup.training, log)
-    study, storage = create_or_load(setup, log)
     stale = fail_interrupted(study, storage)
     if stale:
         log(f"{stale} trial(s) interrupted earlier are recorded as failed")

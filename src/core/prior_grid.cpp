@@ -157,6 +157,19 @@ bool validPolygon(const Polygon& p)
 
 constexpr std::uint16_t kAllSamples = static_cast<std::uint16_t>((1u << kCoverageSamples) - 1u);
 
+/// A buffer holding more than this many times the cells it needs is given back (a small map after a huge one).
+constexpr std::size_t kMaxSpareCapacity = 2;
+
+/// v = n copies of @p value, releasing the old buffer when it is far larger than n.
+template <class T>
+void assignFitted(std::vector<T>& v, std::size_t n, T value)
+{
+  if (v.capacity() > kMaxSpareCapacity * n)
+    std::vector<T>(n, value).swap(v);
+  else
+    v.assign(n, value);
+}
+
 int samplesIn(std::uint16_t bits)
 {
   return __builtin_popcount(static_cast<unsigned>(bits));
@@ -231,10 +244,10 @@ void PriorGrid::build(const VectorMap& map, const GridGeometry& geometry, PriorB
   geometry.validate();
   geometry_ = geometry;
   test_ = test;
-  building_samples_.clear();
-  road_samples_.clear();
-  outline_.clear();
-  labels_.assign(geometry.numCells(), PriorClass::kOther);
+  std::vector<std::uint16_t>().swap(building_samples_);
+  std::vector<std::uint16_t>().swap(road_samples_);
+  std::vector<std::uint8_t>().swap(outline_);
+  assignFitted(labels_, geometry.numCells(), PriorClass::kOther);
   PriorBuildStats local;
   PriorBuildStats& st = stats != nullptr ? *stats : local;
   st = PriorBuildStats{};
@@ -310,9 +323,9 @@ void PriorGrid::sampleCoverage(const VectorMap& map, PriorBuildStats& st)
   if (geometry_.width > std::numeric_limits<int>::max() / k || geometry_.height > std::numeric_limits<int>::max() / k)
     throw ParameterError("cell_test", "the grid is too large for the coverage test");
   const std::size_t n = geometry_.numCells();
-  building_samples_.assign(n, 0);
-  road_samples_.assign(n, 0);
-  outline_.assign(n, 0);
+  assignFitted(building_samples_, n, std::uint16_t{ 0 });
+  assignFitted(road_samples_, n, std::uint16_t{ 0 });
+  assignFitted(outline_, n, std::uint8_t{ 0 });
   GridGeometry fine = geometry_;
   fine.resolution = geometry_.resolution / k;
   fine.width = geometry_.width * k;

@@ -36,17 +36,20 @@ const char* toString(StampVerdict v)
       return "out of order";
     case StampVerdict::kTimeJump:
       return "time jump";
+    case StampVerdict::kLate:
+      return "released late";
   }
   return "unknown";
 }
 
-StampVerdict StampGuard::check(double stamp) const
+StampVerdict StampGuard::check(double stamp, bool clock_watched) const
 {
   if (!std::isfinite(stamp) || stamp <= 0.0) return StampVerdict::kZeroStamp;
   if (!last_) return StampVerdict::kFuse;
   if (stamp > *last_) return StampVerdict::kFuse;
   if (stamp == *last_) return StampVerdict::kDuplicate;
-  return *last_ - stamp > params_.time_jump_threshold ? StampVerdict::kTimeJump : StampVerdict::kOutOfOrder;
+  if (*last_ - stamp <= params_.time_jump_threshold) return StampVerdict::kOutOfOrder;
+  return clock_watched ? StampVerdict::kLate : StampVerdict::kTimeJump;
 }
 
 bool ClockJumpDetector::observe(double now)

@@ -152,7 +152,7 @@ KittiSequence::KittiSequence(const std::string& folder, std::size_t max_frames) 
                                std::to_string(n - 1) + " without a gap");
     labelled_[k] = fs::is_regular_file(labelPath(k));
   }
-  if (max_frames == 0 && fs::is_regular_file(scanPath(n)))
+  if ((max_frames == 0 || n < max_frames) && fs::is_regular_file(scanPath(n)))
     fail(times_path, n + 1, "velodyne/" + frameName(n, ".bin") + " exists but has no time: times.txt is short");
 }
 

@@ -36,6 +36,8 @@ constexpr long kMaxLanes = 64;
 constexpr double kMaxLatitude = 90.0;
 constexpr double kMaxLongitude = 180.0;
 constexpr double kMetresPerKilometre = 1000.0;
+/// Squared distance (m²) standing for "no data point on this side of the globe".
+constexpr double kNoNearest = 1e300;
 /// Vertices closer than this (map units) are merged.
 constexpr double kDuplicateVertexTolerance = 1e-9;
 /// Source coordinates beyond this magnitude are no place on Earth in any CRS (metres, feet or degrees);
@@ -252,6 +254,52 @@ public:
     return std::move(out_);
   }
 
+  /// The geometry path on features given in memory (no file, no driver): geometry checks, repair, projection.
+  core::VectorMap run(const std::vector<SourceFeature>& features)
+  {
+    r_.driver = "memory";
+    for (const SourceFeature& f : features)
+    {
+      ++r_.features_read;
+      const bool line = f.kind == SourceFeature::Kind::kRoadLine;
+      std::unique_ptr<OGRGeometry> g;
+      if (line)
+      {
+        auto lines = std::make_unique<OGRMultiLineString>();
+        for (const auto& part : f.parts)
+        {
+          auto ls = std::make_unique<OGRLineString>();
+          for (const Point2& q : part) ls->addPoint(q.x, q.y);
+          lines->addGeometryDirectly(ls.release());
+        }
+        g = std::move(lines);
+      }
+      else
+      {
+        auto poly = std::make_unique<OGRPolygon>();
+        for (const auto& part : f.parts)
+        {
+          auto ring = std::make_unique<OGRLinearRing>();
+          for (const Point2& q : part) ring->addPoint(q.x, q.y);
+          poly->addRingDirectly(ring.release());
+        }
+        poly->closeRings();  // as every reader hands rings over
+        g = std::move(poly);
+      }
+      if (g->IsEmpty())
+      {
+        ++r_.skipped_missing_nodes;
+        note(f.id, "no geometry");
+        continue;
+      }
+      addGeometry(f.id, line ? Role::kRoadLine : f.kind == SourceFeature::Kind::kBuilding ? Role::kBuilding :
+                                                                                            Role::kRoadArea,
+                  g.get(), nullptr, f.height, f.width, f.road_class);
+    }
+    project();
+    return std::move(out_);
+  }
+
 private:
   struct PendingBuilding
   {
@@ -438,9 +486,38 @@ private:
     return 0;
   }
 
+  /// True when every vertex of @p g is finite (an envelope skips NaN: GEOS must never see one).
+  static bool allFinite(const OGRGeometry* g)
+  {
+    const OGRwkbGeometryType t = wkbFlatten(g->getGeometryType());
+    if (t == wkbPolygon)
+    {
+      const OGRPolygon* p = g->toPolygon();
+      for (const OGRLinearRing* ring : *p)
+        if (!allFinite(ring)) return false;
+      return true;
+    }
+    if (OGR_GT_IsSubClassOf(t, wkbGeometryCollection))
+    {
+      for (const OGRGeometry* part : *g->toGeometryCollection())
+        if (!allFinite(part)) return false;
+      return true;
+    }
+    if (const OGRSimpleCurve* c = OGR_GT_IsCurve(t) ? dynamic_cast<const OGRSimpleCurve*>(g) : nullptr)
+    {
+      for (int i = 0; i < c->getNumPoints(); ++i)
+        if (!std::isfinite(c->getX(i)) || !std::isfinite(c->getY(i))) return false;
+      return true;
+    }
+    OGREnvelope env;
+    g->getEnvelope(&env);
+    return std::isfinite(env.MinX) && std::isfinite(env.MaxX) && std::isfinite(env.MinY) && std::isfinite(env.MaxY);
+  }
+
   /// True when every coordinate of @p g is finite and within kMaxSourceCoordinate.
   static bool coordinatesInRange(const OGRGeometry* g)
   {
+    if (!allFinite(g)) return false;
     OGREnvelope env;
     g->getEnvelope(&env);
     for (const double v : { env.MinX, env.MaxX, env.MinY, env.MaxY })
@@ -680,45 +757,15 @@ private:
         note(id, "nodes missing from the extract");
         continue;
       }
-      if (!coordinatesInRange(g))
+      const double height = role == Role::kBuilding ? buildingHeight(*f) : 0.0;
+      std::string cls;
+      double width = 0.0;
+      if (role == Role::kRoadLine)
       {
-        skipDegenerate(id, "coordinates not finite or beyond 1e9 in the source CRS");
-        continue;
+        cls = field(*f, p_.road_class_attribute);
+        width = roadWidth(*f, cls);
       }
-      if (const std::size_t vertices = vertexCount(g); vertices > static_cast<std::size_t>(p_.max_vertices_per_feature))
-      {
-        ++r_.skipped_too_many_vertices;
-        note(id, std::to_string(vertices) + " vertices, more than max_vertices_per_feature = " +
-                     std::to_string(p_.max_vertices_per_feature));
-        continue;
-      }
-      if (OGRCoordinateTransformation* ct = transformFor(layer))
-      {
-        if (g->transform(ct) != OGRERR_NONE)
-        {
-          skipDegenerate(id, "coordinates cannot be transformed to WGS84");
-          continue;
-        }
-      }
-      if (role == Role::kBuilding || role == Role::kRoadArea)
-      {
-        if (isPolygonal(type))
-          addPolygonal(id, role, g, role == Role::kBuilding ? buildingHeight(*f) : 0.0);
-        else if (std::unique_ptr<OGRPolygon> ring = closedLineAsPolygon(g))
-          addPolygonal(id, role, ring.get(), role == Role::kBuilding ? buildingHeight(*f) : 0.0);
-        else if (isLinear(type))
-        {
-          ++r_.skipped_unclosed;
-          note(id, std::string(role == Role::kBuilding ? "building" : "road area") + " way is not a closed ring");
-        }
-      }
-      else if (isLinear(type))
-      {
-        const std::string cls = field(*f, p_.road_class_attribute);
-        addLinear(id, g, roadWidth(*f, cls), cls);
-      }
-      else if (isPolygonal(type))
-        addPolygonal(id, Role::kRoadArea, g, 0.0);
+      addGeometry(id, role, g, transformFor(layer), height, width, cls);
     }
     // Ways GDAL's OSM driver dropped because their nodes were missing (reported only through CPLDebug).
     for (const std::string& id : errors_.discardedWays())
@@ -731,6 +778,39 @@ private:
       ++r_.skipped_incomplete_relations;
       note(id, "relation (of any kind) ignored by the reader: member ways missing from the extract");
     }
+  }
+
+  /// Range and size checks, transformation to WGS84 (@p ct, null when none), repair, then the pending lists.
+  void addGeometry(const std::string& id, Role role, OGRGeometry* g, OGRCoordinateTransformation* ct, double height,
+                   double width, const std::string& cls)
+  {
+    const OGRwkbGeometryType type = g->getGeometryType();
+    if (!coordinatesInRange(g)) return skipDegenerate(id, "coordinates not finite or beyond 1e9 in the source CRS");
+    if (const std::size_t vertices = vertexCount(g); vertices > static_cast<std::size_t>(p_.max_vertices_per_feature))
+    {
+      ++r_.skipped_too_many_vertices;
+      note(id, std::to_string(vertices) + " vertices, more than max_vertices_per_feature = " +
+                   std::to_string(p_.max_vertices_per_feature));
+      return;
+    }
+    if (ct != nullptr && g->transform(ct) != OGRERR_NONE)
+      return skipDegenerate(id, "coordinates cannot be transformed to WGS84");
+    if (role == Role::kBuilding || role == Role::kRoadArea)
+    {
+      if (isPolygonal(type))
+        addPolygonal(id, role, g, height);
+      else if (std::unique_ptr<OGRPolygon> ring = closedLineAsPolygon(g))
+        addPolygonal(id, role, ring.get(), height);
+      else if (isLinear(type))
+      {
+        ++r_.skipped_unclosed;
+        note(id, std::string(role == Role::kBuilding ? "building" : "road area") + " way is not a closed ring");
+      }
+    }
+    else if (isLinear(type))
+      addLinear(id, g, width, cls);
+    else if (isPolygonal(type))
+      addPolygonal(id, Role::kRoadArea, g, 0.0);
   }
 
   template <class F>
@@ -808,7 +888,7 @@ private:
     r_.origin_altitude = p_.origin_altitude;
 
     const double max_d2 = p_.max_origin_distance * p_.max_origin_distance;
-    double nearest2 = 1e300;
+    double nearest2 = kNoNearest;
     auto nearFeature = [&](const Ring& ring, bool& near) {
       bool far_side = false;
       for (const auto& q : ring)
@@ -872,9 +952,12 @@ private:
     {
       std::ostringstream why;
       why.precision(1);
-      why << std::fixed << "the origin (" << r_.origin_latitude << ", " << r_.origin_longitude << ") is "
-          << std::sqrt(nearest2) / kMetresPerKilometre << " km from the nearest data, more than max_origin_distance = "
-          << p_.max_origin_distance / kMetresPerKilometre << " km";
+      why << std::fixed << "the origin (" << r_.origin_latitude << ", " << r_.origin_longitude << ") is ";
+      if (std::isfinite(nearest2) && nearest2 < kNoNearest)
+        why << std::sqrt(nearest2) / kMetresPerKilometre << " km from the nearest data";
+      else
+        why << "on the other side of the globe from all the data (more than a quarter of the Earth away)";
+      why << ", more than max_origin_distance = " << p_.max_origin_distance / kMetresPerKilometre << " km";
       fail(why.str());
     }
     r_.buildings = out_.buildings.size();
@@ -978,6 +1061,20 @@ core::VectorMap loadVectorMap(const MapLoadParams& params, MapLoadReport* report
   r.file = params.file;
   Loader loader(params, r);
   return loader.run();
+}
+
+core::VectorMap buildVectorMap(const std::vector<SourceFeature>& features, const MapLoadParams& params,
+                               MapLoadReport* report)
+{
+  MapLoadParams p = params;
+  if (p.file.empty()) p.file = "(in memory)";  // named in errors; nothing is opened
+  p.validate();
+  MapLoadReport local;
+  MapLoadReport& r = report != nullptr ? *report : local;
+  r = MapLoadReport{};
+  r.file = p.file;
+  Loader loader(p, r);
+  return loader.run(features);
 }
 
 std::string summary(const MapLoadReport& r)

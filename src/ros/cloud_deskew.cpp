@@ -130,8 +130,10 @@ DeskewResult CloudDeskewer::apply(const sensor_msgs::PointCloud2& cloud, const c
   }
   if (r.span < kMinSpan)
   {
-    r.status = "applied";
-    r.applied = true;
+    // Every point at the stamp: a driver that declares the field but does not fill it, not a deskewed sweep.
+    r.status = "time_field_constant";
+    r.detail = "every point of a cloud stamped " + std::to_string(stamp) + " has the same time in field '" +
+               field.name + "': nothing to deskew with";
     return r;
   }
   core::SweepMotion motion;

@@ -1,5 +1,10 @@
 #include "map_aided_fusion/ros/fusion_worker.hpp"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -216,6 +221,9 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
   }
   std::lock_guard<std::mutex> lock(mutex_);
   softener_.setPrior(prior);
+#ifdef __GLIBC__
+  malloc_trim(0);  // the previous prior (possibly a huge map's) is freed: give its pages back
+#endif
   ROS_INFO_STREAM("fusion: prior grid " << prior->geometry.width << "x" << prior->geometry.height << " cells at "
                                         << prior->geometry.resolution << " m");
 }
@@ -277,14 +285,17 @@ void FusionWorker::onScanIn(const EvidentialGrid::ConstPtr& msg)
       return;
     }
     const ros::Time now = ros::Time::now();
-    if (!now.isZero() && stamp > now.toSec() + node_params_.future_tolerance)
+    const double ahead = now.isZero() ? 0.0 : stamp - now.toSec();
+    const bool after_jump = core::steadySeconds() - last_jump_wall_ < core::kAfterJumpWatch;
+    if (ahead > node_params_.future_tolerance || (after_jump && ahead > node_params_.time.time_jump_threshold))
     {
       countLost(counters_.future_stamp);
       ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << ", "
                                                                      << stamp - now.toSec()
                                                                      << " s ahead of the clock (future_tolerance "
-                                                                     << node_params_.future_tolerance
-                                                                     << " s), dropped; " << counters_.future_stamp
+                                                                     << node_params_.future_tolerance << " s"
+                                                                     << (after_jump ? ", after a backward clock jump" : "")
+                                                                     << "), dropped; " << counters_.future_stamp
                                                                      << " so far");
       return;
     }
@@ -307,6 +318,7 @@ void FusionWorker::resetForTimeJump(const std::string& why)
   tf_buffer_.clear();
   ++counters_.resets;
   ++counters_.tf_clears;
+  last_jump_wall_ = core::steadySeconds();
 }
 
 void FusionWorker::checkClock()
@@ -315,6 +327,7 @@ void FusionWorker::checkClock()
   if (now.isZero()) return;
   std::string frame;
   bool jumped = false;
+  double watch = node_params_.future_tolerance;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     jumped = clock_jump_.observe(now.toSec());
@@ -326,6 +339,8 @@ void FusionWorker::checkClock()
       resetForTimeJump(why.str());
     }
     frame = last_scan_frame_;
+    if (core::steadySeconds() - last_jump_wall_ < core::kAfterJumpWatch)
+      watch = std::min(watch, node_params_.time.time_jump_threshold);
   }
   if (jumped)
   {
@@ -334,7 +349,8 @@ void FusionWorker::checkClock()
   }
   if (frame.empty()) return;
   // After a jump, transforms of the previous loop may still arrive; tf2 would then ignore the new loop's
-  // transforms as too old. Transforms ahead of the clock by more than the threshold are from the past loop.
+  // transforms as too old. Transforms ahead of the clock by more than time_jump_threshold soon after a jump, or by
+  // more than future_tolerance at any time, are from the past loop; a clock that merely lags keeps its tf.
   ros::Time latest;
   try
   {
@@ -344,7 +360,7 @@ void FusionWorker::checkClock()
   {
     return;
   }
-  if ((latest - now).toSec() > node_params_.time.time_jump_threshold)
+  if ((latest - now).toSec() > watch)
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ROS_WARN_STREAM("fusion: the tf buffer holds " << node_params_.map_frame << " <- " << frame << " at " << latest
@@ -425,7 +441,8 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     pending_params_.reset();
   }
   const double stamp = msg->header.stamp.toSec();
-  switch (stamp_guard_.check(stamp))
+  // checkClock() watches ROS time and resets the guard when it goes back; before the first clock value, stamps decide.
+  switch (stamp_guard_.check(stamp, !ros::Time::now().isZero()))
   {
     case core::StampVerdict::kFuse:
       break;
@@ -445,6 +462,24 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
                                                                      << " s older than the last fused scan, dropped "
                                                                         "(out of order); "
                                                                      << counters_.out_of_order << " so far");
+      return;
+    case core::StampVerdict::kLate:
+      if (stamp_guard_.lateRun(core::steadySeconds()))
+      {
+        std::ostringstream why;
+        why << "scans have stayed older than the last fused one (" << std::fixed << *stamp_guard_.last() << " s, now "
+            << stamp << " s) for more than time_jump_threshold (" << node_params_.time.time_jump_threshold
+            << " s) of wall time: the data's time went back without the clock";
+        resetForTimeJump(why.str());
+        break;
+      }
+      countLost(counters_.late);
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << " is "
+                                                                     << *stamp_guard_.last() - stamp
+                                                                     << " s older than the last fused scan while the "
+                                                                        "clock did not go back: released late (after "
+                                                                        "a tf gap), dropped; "
+                                                                     << counters_.late << " so far");
       return;
     case core::StampVerdict::kTimeJump: {
       std::ostringstream why;
@@ -601,6 +636,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("scans dropped (future stamp)", counters_.future_stamp);
   status.add("scans dropped (out of order)", counters_.out_of_order);
   status.add("scans dropped (duplicate stamp)", counters_.duplicate);
+  status.add("scans dropped (released late)", counters_.late);
   status.add("grid resets (time jump)", counters_.resets);
   status.add("tf buffer clears", counters_.tf_clears);
   status.add("pose jumps", counters_.pose_jumps);

@@ -1,5 +1,9 @@
 #include "map_aided_fusion/ros/prior_grid_node.hpp"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include <algorithm>
 #include <vector>
 
@@ -174,6 +178,9 @@ bool PriorGridNode::load()
     loaded_ = false;
   }
   if (!loaded_) ROS_ERROR_STREAM("prior_grid: " << status_ << "; nothing published");
+#ifdef __GLIBC__
+  malloc_trim(0);  // the vector map and the previous grid are freed: give the pages back (a huge map, then a small one)
+#endif
   return loaded_;
 }
 

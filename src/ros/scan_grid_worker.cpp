@@ -58,6 +58,7 @@ void ScanGridNodeParams::validate() const
   core::requireInRange("future_tolerance", future_tolerance, 0.0, kMaxFutureTolerance);
   core::requireInRange("time_jump_threshold", time_jump_threshold, kMinJumpThreshold, kMaxJumpThreshold);
   health.validate();
+  input.validate();
   model.validate();
 }
 
@@ -72,6 +73,7 @@ ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
   readParam(pnh, "deskew_fixed_frame", p.deskew_fixed_frame);
   readParam(pnh, "deskew_time_field", p.deskew_time_field);
   core::forEachParam(p.health, parameterServerReader(pnh));
+  core::forEachParam(p.input, parameterServerReader(pnh));
   core::forEachParam(p.model, parameterServerReader(pnh));
   p.validate();
   return p;
@@ -104,8 +106,9 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   updater_->setHardwareID("scan_grid");
   updater_->add("ScanGrid", this, &ScanGridWorker::diagnose);
+  gaps_ = core::InputGapCounter(params_.input.input_period);
   for (auto* w : { &received_window_, &published_window_, &rejected_window_, &deskew_skipped_window_,
-                   &ground_fallback_window_ })
+                   &ground_fallback_window_, &lost_window_, &overrun_window_, &stream_gap_window_ })
     w->setSpan(params_.health.diagnostic_window);
   start_wall_ = core::steadySeconds();
   clock_jump_.setThreshold(params_.time_jump_threshold);
@@ -167,6 +170,7 @@ void ScanGridWorker::checkClock()
     std::lock_guard<std::mutex> lock(mutex_);
     if (!clock_jump_.observe(now.toSec())) return;
     ++tf_clears_;
+    last_jump_wall_ = core::steadySeconds();
     ROS_WARN("scan_grid: ROS time went back by more than time_jump_threshold (%.3f s) to %.3f; clearing the tf "
              "buffer and the clouds waiting for a transform",
              params_.time_jump_threshold, now.toSec());
@@ -177,6 +181,11 @@ void ScanGridWorker::checkClock()
 
 void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
+  struct MarkEnd
+  {
+    std::atomic<double>& end;
+    ~MarkEnd() { end = core::steadySeconds(); }
+  } mark_end{ last_callback_end_ };
   checkClock();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -195,12 +204,38 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
       return;
     }
     const ros::Time now = ros::Time::now();
-    if (!now.isZero() && (cloud->header.stamp - now).toSec() > params_.future_tolerance)
+    const double ahead = now.isZero() ? 0.0 : (cloud->header.stamp - now).toSec();
+    if (ahead > params_.future_tolerance)
     {
-      reject("future_stamp", "stamped " + std::to_string((cloud->header.stamp - now).toSec()) +
-                                 " s ahead of the clock (future_tolerance " + std::to_string(params_.future_tolerance) +
-                                 " s)");
+      reject("future_stamp", "stamped " + std::to_string(ahead) + " s ahead of the clock (future_tolerance " +
+                                 std::to_string(params_.future_tolerance) + " s)");
       return;
+    }
+    if (core::steadySeconds() - last_jump_wall_ < core::kAfterJumpWatch && ahead > params_.time_jump_threshold)
+    {
+      reject("before_time_jump", "stamped " + std::to_string(ahead) +
+                                     " s ahead of a clock that went back: a cloud of before the jump");
+      return;
+    }
+    if (const std::size_t lost = gaps_.observe(cloud->header.stamp.toSec()); lost > 0)
+    {
+      // Waiting idle for more than 1.5 periods means the queue was empty: the stream itself had the gap.
+      const double idle = core::steadySeconds() - last_callback_end_.load();
+      if (idle > core::InputGapCounter::kLostGapFactor * gaps_.period())
+      {
+        stream_gaps_ += lost;
+        stream_gap_window_.add(core::steadySeconds(), lost);
+      }
+      else
+      {
+        clouds_lost_ += lost;
+        lost_window_.add(core::steadySeconds(), lost);
+        ROS_WARN_THROTTLE(1.0, "scan_grid: %zu clouds on %s lost in the input queue (a stamp gap of %zu periods of "
+                               "%.3f s while busy): processing is slower than the input; raise input_queue_size (%d) "
+                               "or lighten the load; %zu so far",
+                          lost, cloud_sub_.getTopic().c_str(), lost + 1, gaps_.period(), params_.input_queue_size,
+                          clouds_lost_);
+      }
     }
     const std::string& frame = cloud->header.frame_id;
     const std::string source = tfFrame(frame);
@@ -271,6 +306,7 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
     return;
   }
   counters_.points_rejected += last_stats_.rejected();
+  if (blindCloud(last_stats_)) return;
   if (last_stats_.ground_fit.flat_fallback)
   {
     ++ground_flat_fallbacks_;
@@ -305,6 +341,31 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   window_processing_sum_ += elapsed;
   window_processing_max_ = std::max(window_processing_max_, elapsed);
   ++window_processed_;
+  if (gaps_.period() > 0.0 && elapsed > gaps_.period())
+  {
+    ++overruns_;
+    overrun_window_.add(last_published_wall_);
+  }
+}
+
+bool ScanGridWorker::blindCloud(const core::ScanGridStats& stats)
+{
+  const std::size_t valid = stats.points - stats.non_finite - stats.no_return;
+  const core::BlindReason why = core::judgeReturns(stats.points, valid, params_.input);
+  if (why == core::BlindReason::kNone)
+  {
+    if (blind_.active())
+      ROS_INFO("scan_grid: %s sees again (%zu valid returns) after %zu blind clouds", cloud_sub_.getTopic().c_str(),
+               valid, blind_.clouds());
+    blind_.sighted();
+    return false;
+  }
+  blind_.blind(core::steadySeconds());
+  last_blind_reason_ = core::toString(why);
+  reject(last_blind_reason_, std::to_string(valid) + " valid returns of " + std::to_string(stats.points) +
+                                 " points (min_valid_returns " + std::to_string(params_.input.min_valid_returns) +
+                                 "): the lidar is blind; not fused, the MapGrid keeps its evidence");
+  return true;
 }
 
 void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level*/)
@@ -349,12 +410,29 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
                                                      static_cast<double>(window_processed_) :
                                                  0.0;
   const bool ever = counters_.clouds_published > 0;
-  const core::HealthSummary h = core::streamHealth(params_.health, ever, ever ? now - last_published_wall_ : 0.0,
-                                                   published, rejected, "clouds published");
+  core::InputFindings found;
+  found.blind = blind_.active();
+  found.blind_for = blind_.duration(now);
+  found.blind_clouds = blind_.clouds();
+  found.blind_reason = last_blind_reason_;
+  found.lost = lost_window_.count(now);
+  found.overruns = overrun_window_.count(now);
+  const core::HealthSummary h = core::inputHealth(
+      core::streamHealth(params_.health, ever, ever ? now - last_published_wall_ : 0.0, published, rejected,
+                         "clouds published"),
+      params_.health, found);
   status.summary(static_cast<unsigned char>(h.level), h.message);
   status.add("input rate (Hz)", received_window_.rate(now, start_wall_));
   status.add("output rate (Hz)", published_window_.rate(now, start_wall_));
   status.add("clouds rejected in window", rejected);
+  status.add("lidar blind for (s)", found.blind_for);
+  status.add("clouds lost in the input queue in window", found.lost);
+  status.add("clouds lost in the input queue", clouds_lost_);
+  status.add("clouds processed slower than they come in window", found.overruns);
+  status.add("clouds processed slower than they come", overruns_);
+  status.add("clouds missing from the stream in window", stream_gap_window_.count(now));
+  status.add("clouds missing from the stream", stream_gaps_);
+  status.add("input period (s)", gaps_.period());
   status.add("window (s)", params_.health.diagnostic_window);
   status.add("processing time mean (ms)", mean_ms);
   status.add("processing time max (ms)", kMillisecondsPerSecond * window_processing_max_);

@@ -514,6 +514,10 @@ int main(int argc, char** argv)
     // Ground truth: simulator cells, labelled points (SemanticKITTI) or labelled boxes (KITTI tracking).
     const bool object_mode = truth.empty() && !truth_objects.empty();
     const bool point_mode = truth.empty() && !object_mode;
+    const bool objects_missing = !truth.empty() && truth_objects.empty();
+    if (objects_missing)
+      std::cerr << "evaluate: " << opt.bag << " has /ground_truth/classes but no /ground_truth/objects: cells are "
+                << "scored, objects, movers and tracks are not (their columns read 0/0)\n";
     if (point_mode && labelled_stamps.empty())
       throw std::runtime_error(opt.bag + " has neither /ground_truth/classes (simulator), /ground_truth/points "
                                          "(labelled real points, kitti_to_bag) nor /ground_truth/objects (labelled "
@@ -1004,8 +1008,12 @@ int main(int argc, char** argv)
     }
     else
     {
+      if (objects_missing) meta["objects_scored"] = "false: the bag has no /ground_truth/objects";
       std::ofstream(fs::path(opt.out) / "metrics.json") << eval::toJson(scores, meta);
-      markdown = eval::toMarkdown(scores) + "\n" + moversSection(scores, false) + tracksSection(scores);
+      markdown = (objects_missing ? std::string("**Objects not scored**: the bag has no `/ground_truth/objects`; the "
+                                                "object, mover and track figures below read 0/0.\n\n") :
+                                    std::string()) +
+                 eval::toMarkdown(scores) + "\n" + moversSection(scores, false) + tracksSection(scores);
     }
     std::ofstream(fs::path(opt.out) / "metrics.md") << "# map_aided_fusion evaluation\n\nBag: `" << opt.bag << "`, "
                                                      << done << " scans"

@@ -182,6 +182,26 @@ TEST(Kitti, FaultsNameTheFileAndLineAndLeaveNoBag)
     EXPECT_NE(e.find("missing"), std::string::npos) << e;
   }
   {
+    // times.txt with one line for three sweeps: an error naming it, also when fewer frames than there are are asked
+    // for (the converter's --frames), never a one-scan bag.
+    Folder f("short_times");
+    writeSequence(f);
+    f.text("times.txt", "0.0\n");
+    for (const std::size_t frames : { std::size_t{ 0 }, std::size_t{ 2 }, std::size_t{ 10 } })
+    {
+      std::string e;
+      try
+      {
+        KittiSequence s(f.dir.string(), frames);
+      }
+      catch (const KittiError& x)
+      {
+        e = x.what();
+      }
+      EXPECT_NE(e.find("times.txt is short"), std::string::npos) << "frames " << frames << ": " << e;
+    }
+  }
+  {
     Folder f("short_poses");
     writeSequence(f);
     f.text("poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 1\n");

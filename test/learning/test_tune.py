@@ -142,6 +142,7 @@ def test_unreachable_storage_is_a_one_line_error(tmp_path):
                   "--trials", "1"], timeout=120)
     line = one_line_error(r)
     assert line.startswith("tune: storage postgresql://maf:***@127.0.0.1:1/maf: cannot open it")
+    assert not list((tmp_path / "w").rglob("*.bag")), "drives simulated before the storage was reached"
     r = run_tune(["--drives", ds, "--work", str(tmp_path / "w"), "--storage", "mysql://x/y", "--trials", "1"])
     assert "unknown kind" in one_line_error(r)
 
@@ -161,6 +162,8 @@ def test_unknown_scenario_key_is_a_one_line_error(tmp_path):
     ("fusion.yaml: {combination_rule: {choices: [modified_yager, murphy]}}\n", "combination_rule"),
     ("fusion.yaml: {alpha_statc: [0.0, 0.1]}\n", "alpha_statc: not a parameter of config/fusion.yaml"),
     ("fusions.yaml: {alpha_static: [0.0, 0.1]}\n", "'fusions.yaml' is not a configuration file"),
+    ("fusion.yaml: 5\n", "fusion.yaml: must map parameters to ranges"),
+    ("[alpha_static, 0.1]\n", "must map config files to parameters"),
 ])
 def test_bad_search_space_is_a_one_line_error_naming_the_parameter(tmp_path, tools, text, named):
     ds = write_drive_set(str(tmp_path / "drives.yaml"), training=[("town", 1, "ibeo4")])

@@ -235,6 +235,23 @@ TEST(PriorGrid, BlocksGiveExactClassCounts)
   EXPECT_EQ(grid.bytes(), 1600u);
 }
 
+TEST(PriorGrid, ASmallMapAfterAHugeOneGivesTheMemoryBack)
+{
+  // The map loader reloads into the same grid: its buffers must follow the new map, not stay at the peak.
+  GridGeometry huge = testGrid();
+  huge.width = huge.height = 3000;
+  PriorGrid grid;
+  for (const PriorCellTest test : { PriorCellTest::kCentre, PriorCellTest::kCoverage })
+  {
+    grid.build(blocks(), huge, nullptr, test);
+    grid.build(blocks(), testGrid(), nullptr, test);
+    EXPECT_EQ(grid.labels().size(), testGrid().numCells());
+    EXPECT_LE(grid.labels().capacity(), 2 * testGrid().numCells()) << "labels kept the huge map's buffer";
+    EXPECT_LE(grid.bytes(), 6 * testGrid().numCells());
+    EXPECT_EQ(grid.labelAt({ 0.5, -9.5 }), PriorClass::kRoad);
+  }
+}
+
 TEST(PriorGrid, BuildingsWinCourtyardsStayOtherAndOutsideIsUnknown)
 {
   PriorGrid grid;

@@ -174,9 +174,20 @@ TEST(MapReaderFaults, DataOnTheFarSideOfTheGlobeIsNotPlacedNearTheOrigin)
   EXPECT_EQ(report.skipped_out_of_range, 2u);
   for (const auto& q : m.buildings[0].footprint.outer) EXPECT_LT(std::hypot(q.x, q.y), 20.0);
 
-  // Only the antipode: an error, not a building at the origin.
+  // Only the antipode: an error that says where the data are, not a building at the origin nor 10^147 km.
   p.file = writeTemp("antipode.geojson", featureCollection(antipode));
-  EXPECT_THROW(map_io::loadVectorMap(p), map_io::MapLoadError);
+  try
+  {
+    map_io::loadVectorMap(p);
+    ADD_FAILURE() << "the antipode was loaded";
+  }
+  catch (const map_io::MapLoadError& e)
+  {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("other side of the globe"), std::string::npos) << what;
+    EXPECT_EQ(what.find("e+"), std::string::npos) << what;
+    EXPECT_LT(what.size(), 400u) << what;
+  }
 
   // A map across the antimeridian with an automatic origin: the origin is on the data, not at longitude 0.
   p.file = writeTemp("across.geojson", featureCollection(across));
@@ -185,6 +196,52 @@ TEST(MapReaderFaults, DataOnTheFarSideOfTheGlobeIsNotPlacedNearTheOrigin)
   ASSERT_EQ(a.buildings.size(), 1u);
   EXPECT_NEAR(std::abs(report.origin_longitude), 180.0, 1e-3);
   for (const auto& q : a.buildings[0].footprint.outer) EXPECT_LT(std::hypot(q.x, q.y), 20.0);
+}
+
+TEST(MapReaderFaults, TheInMemoryGeometryPathGivesWhatTheFileGives)
+{
+  // The path fuzz/fuzz_map_geometry.cpp drives: the same features from memory and from a GeoJSON file give the
+  // same projected map, with the same repairs and skips.
+  const std::string square = "[[2.0,49.0],[2.0001,49.0],[2.0001,49.0001],[2.0,49.0001],[2.0,49.0]]";
+  const std::string bowtie = "[[2.0002,49.0],[2.0003,49.0001],[2.0003,49.0],[2.0002,49.0001],[2.0002,49.0]]";
+  const std::string stray_hole = "[[2.0010,49.0010],[2.0011,49.0010],[2.0011,49.0011],[2.0010,49.0011],"
+                                 "[2.0010,49.0010]]";
+  map_io::MapLoadParams p;
+  p.origin_latitude = 49.0;
+  p.origin_longitude = 2.0;
+  p.file = writeTemp("memory.geojson", featureCollection(building(square + "," + stray_hole) + "," + building(bowtie)));
+  map_io::MapLoadReport from_file, from_memory;
+  const core::VectorMap a = map_io::loadVectorMap(p, &from_file);
+  using map_io::SourceFeature;
+  const auto ring = [](std::initializer_list<core::Point2> pts) { return std::vector<core::Point2>(pts); };
+  std::vector<SourceFeature> features(2);
+  features[0].parts = { ring({ { 2.0, 49.0 }, { 2.0001, 49.0 }, { 2.0001, 49.0001 }, { 2.0, 49.0001 } }),
+                        ring({ { 2.0010, 49.0010 }, { 2.0011, 49.0010 }, { 2.0011, 49.0011 }, { 2.0010, 49.0011 } }) };
+  features[1].parts = { ring({ { 2.0002, 49.0 }, { 2.0003, 49.0001 }, { 2.0003, 49.0 }, { 2.0002, 49.0001 } }) };
+  p.file.clear();
+  const core::VectorMap b = map_io::buildVectorMap(features, p, &from_memory);
+  ASSERT_EQ(a.buildings.size(), b.buildings.size());
+  EXPECT_EQ(from_file.repaired_geometries, 1u);
+  EXPECT_EQ(from_memory.repaired_geometries, from_file.repaired_geometries);
+  EXPECT_EQ(from_memory.dropped_holes, 1u);
+  EXPECT_EQ(from_memory.driver, "memory");
+  for (std::size_t i = 0; i < a.buildings.size(); ++i)
+  {
+    ASSERT_EQ(a.buildings[i].footprint.outer.size(), b.buildings[i].footprint.outer.size()) << i;
+    for (std::size_t k = 0; k < a.buildings[i].footprint.outer.size(); ++k)
+    {
+      EXPECT_NEAR(a.buildings[i].footprint.outer[k].x, b.buildings[i].footprint.outer[k].x, 1e-9);
+      EXPECT_NEAR(a.buildings[i].footprint.outer[k].y, b.buildings[i].footprint.outer[k].y, 1e-9);
+    }
+  }
+  // A NaN vertex, a line with one point and nothing usable: counted skips, then the loader's own error.
+  std::vector<SourceFeature> bad(2);
+  bad[0].parts = { ring({ { 2.0, 49.0 }, { std::nan(""), 49.0 }, { 2.0001, 49.0001 } }) };
+  bad[1].kind = SourceFeature::Kind::kRoadLine;
+  bad[1].parts = { ring({ { 2.0, 49.0 } }) };
+  map_io::MapLoadReport r;
+  EXPECT_THROW(map_io::buildVectorMap(bad, p, &r), map_io::MapLoadError);
+  EXPECT_EQ(r.skipped_degenerate, 2u) << "the NaN vertex must be caught before GEOS";
 }
 
 TEST(MapReaderFaults, FeatureWithTooManyVerticesIsSkippedAndCounted)

@@ -142,4 +142,7 @@ TEST(CloudDeskew, CloudsLeftAsTheyAreSayWhy)
   EXPECT_EQ(run(withTime(7, std::numeric_limits<float>::quiet_NaN())), "time_non_finite");
   EXPECT_EQ(run(withTime(7, -0.05f)), "time_negative");
   EXPECT_EQ(run(withTime(7, 0.5f)), "time_out_of_sweep");
+  sensor_msgs::PointCloud2 zeros = sweep();  // the field is there, every time 0: not "applied"
+  for (std::uint32_t k = 0; k < zeros.width; ++k) std::memset(zeros.data.data() + k * zeros.point_step + 12, 0, 4);
+  EXPECT_EQ(run(zeros), "time_field_constant");
 }

@@ -133,6 +133,21 @@ public:
   {
     points_.publish(makeCloud({ Box{ 8.0, 3.0, 12.5, 5.0, 1.5 } }, stamp, frame));
   }
+  /// A blind sweep: every point NaN (a fogged window), or no point at all (@p empty).
+  void sendBlindCloud(const ros::Time& stamp, bool empty)
+  {
+    sensor_msgs::PointCloud2 c = makeCloud({}, stamp);
+    if (empty)
+    {
+      sensor_msgs::PointCloud2Modifier(c).resize(0);
+    }
+    else
+    {
+      for (sensor_msgs::PointCloud2Iterator<float> it(c, "x"); it != it.end(); ++it)
+        it[0] = it[1] = it[2] = std::numeric_limits<float>::quiet_NaN();
+    }
+    points_.publish(c);
+  }
 
   /// Spins on wall time while @p done is false, at most @p seconds; true when done.
   template <class F>
@@ -367,6 +382,99 @@ TEST(Faults, Item11_FutureDuplicatePoseJumpAreCounted)
   EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
 }
 
+TEST(Faults, Item12_BlindLidarIsReportedNotFusedAndTheGridKept)
+{
+  setUpPipeline();
+  drive(5);
+  probe->spinFor(0.5);
+  const std::size_t known = probe->knownCells();
+  ASSERT_GT(known, 100u);
+  const double fused = probe->value("fusion", "scans fused");
+  const double non_finite = std::max(0.0, probe->value("scan_grid", "clouds rejected: blind_non_finite"));
+  const double empty = std::max(0.0, probe->value("scan_grid", "clouds rejected: blind_empty"));
+  // 4 s of all-NaN sweeps, then 1 s of empty ones, at 10 Hz with the vehicle's poses.
+  bool warned = false;
+  for (int k = 0; k < 50; ++k)
+  {
+    const ros::Time t = ros::Time::now();
+    probe->sendPose(t);
+    probe->spinFor(0.02);
+    probe->sendBlindCloud(t, k >= 40);
+    probe->spinFor(kScanPeriod);
+    warned = warned || (probe->level("scan_grid") == diagnostic_msgs::DiagnosticStatus::WARN &&
+                        probe->message("scan_grid").find("lidar blind for") != std::string::npos);
+  }
+  probe->spinFor(1.2);
+  EXPECT_TRUE(warned) << "never WARN 'lidar blind' during the first seconds";
+  EXPECT_EQ(probe->level("scan_grid"), diagnostic_msgs::DiagnosticStatus::ERROR) << probe->message("scan_grid");
+  EXPECT_NE(probe->message("scan_grid").find("lidar blind for"), std::string::npos) << probe->message("scan_grid");
+  EXPECT_GE(probe->value("scan_grid", "lidar blind for (s)"), 4.0);
+  EXPECT_GE(probe->value("scan_grid", "clouds rejected: blind_non_finite") - non_finite, 35.0);
+  EXPECT_GE(probe->value("scan_grid", "clouds rejected: blind_empty") - empty, 8.0);
+  EXPECT_EQ(probe->value("fusion", "scans fused"), fused) << "a blind cloud reached the MapGrid";
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
+  // Sight returns: the decided cells were kept, and the blind spell is over.
+  drive(3);
+  probe->spinFor(0.5);
+  EXPECT_GE(probe->knownCells(), known * 9 / 10) << "evidence was worn away while blind";
+  EXPECT_TRUE(probe->waitFor([] { return probe->value("scan_grid", "lidar blind for (s)") == 0.0; }, kSettle));
+}
+
+TEST(Faults, Item13_CloudsLostInAFullInputQueueAreCountedAndWarned)
+{
+  setUpPipeline();
+  drive(3);
+  probe->spinFor(0.5);
+  const double lost = std::max(0.0, probe->value("scan_grid", "clouds lost in the input queue"));
+  // Which clouds of the burst the ScanGrid processed, from the stamps of its published grids.
+  std::mutex seen_mutex;
+  std::vector<ros::Time> seen;
+  ros::NodeHandle nh;
+  ros::Subscriber grids = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "/map_aided_fusion/scan_grid/occupancy", 100, [&](const nav_msgs::OccupancyGrid::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(seen_mutex);
+        seen.push_back(m->header.stamp);
+      });
+  ASSERT_TRUE(probe->waitFor([&] { return grids.getNumPublishers() > 0; }, 5.0));
+  probe->spinFor(0.3);
+  // A burst far faster than the ScanGrid (input_queue_size 2) takes: stamps 0.1 s apart, sent back to back,
+  // older than the fused scans so that the fusion drops them (released late) and its state is left alone.
+  const ros::Time base = ros::Time::now() - ros::Duration(8.0);
+  constexpr int kBurst = 60;
+  std::vector<sensor_msgs::PointCloud2> burst;
+  for (int k = 0; k <= kBurst; ++k) burst.push_back(makeCloud({ Box{ 8.0, 3.0, 12.5, 5.0, 1.5 } },
+                                                              base + ros::Duration(0.1 * k)));
+  // A full queue drops its oldest cloud: the last of the burst gets through, and every gap after the first
+  // cloud processed is judged.
+  for (int k = 0; k <= kBurst; ++k) probe->points_.publish(burst[k]);
+  probe->spinFor(1.0);
+  ASSERT_TRUE(probe->waitFor(
+      [&] { return probe->level("scan_grid") >= diagnostic_msgs::DiagnosticStatus::WARN &&
+                   probe->value("scan_grid", "clouds lost in the input queue") > lost; },
+      kSettle));
+  int first = kBurst + 1, got = 0;
+  {
+    std::lock_guard<std::mutex> lock(seen_mutex);
+    for (const ros::Time& t : seen)
+      for (int k = 0; k <= kBurst; ++k)
+        if (t == burst[k].header.stamp)
+        {
+          first = std::min(first, k);
+          ++got;
+        }
+  }
+  const double counted = probe->value("scan_grid", "clouds lost in the input queue") - lost;
+  ASSERT_GT(got, 1);
+  ASSERT_LT(got, kBurst + 1 - first) << "the burst did not overflow the input queue";
+  EXPECT_EQ(counted, kBurst + 1 - first - got) << "processed " << got << " of " << kBurst + 1 - first
+                                               << " from the first processed on";
+  EXPECT_NE(probe->message("scan_grid").find("lost in the input queue"), std::string::npos)
+      << probe->message("scan_grid");
+  EXPECT_GE(probe->value("scan_grid", "clouds lost in the input queue in window"), counted);
+  drive(3);
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
+}
+
 // ------------------------------------------------------------------------------------------------
 // Simulated time (test/bag_loop.test): a 3 s drive recorded once, replayed three times with /clock going back
 // at each loop, as `rosbag play --clock --loop` does; a transform from the end of a loop arrives after the
@@ -422,6 +530,106 @@ TEST(BagLoop, ThreeLoopsResetOnceEachAndLoseNoScan)
   EXPECT_GE(probe->messages("fusion"), n + 2) << "diagnostics stopped";
   EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion") != diagnostic_msgs::DiagnosticStatus::OK; }, 4.0))
       << "OK while nothing is fused: " << probe->message("fusion");
+}
+
+// ------------------------------------------------------------------------------------------------
+// Simulated time with the fusion's tf_queue_size at 20 (test/clock_lag.test): a /clock that falls 2 s behind
+// the data, as `rosbag play --clock` does on a loaded machine, then a 3 s tf gap.
+// ------------------------------------------------------------------------------------------------
+
+class SimClock
+{
+public:
+  SimClock()
+  {
+    ros::NodeHandle nh;
+    pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  }
+  void set(double t)
+  {
+    rosgraph_msgs::Clock c;
+    c.clock = ros::Time(t);
+    pub_.publish(c);
+  }
+
+private:
+  ros::Publisher pub_;
+};
+
+SimClock* sim_clock = nullptr;
+constexpr double kSimStart = 2000.0;
+double sim_data = kSimStart;  ///< stamp of the last scan sent
+
+/// One scan at data time @p t with the clock at @p clock; the pose too unless @p with_pose is false.
+void simScan(double t, double clock, bool with_pose = true)
+{
+  sim_clock->set(clock);
+  if (with_pose) probe->sendPose(ros::Time(t), 0.5 * (t - kSimStart));
+  probe->spinFor(0.02);
+  probe->sendCloud(ros::Time(t));
+  probe->spinFor(kScanPeriod);
+  sim_data = t;
+}
+
+TEST(ClockLag, AClockFallingBehindTheDataClearsAndLosesNothing)
+{
+  static SimClock clock;  // lives for the ClockLag tests that follow
+  sim_clock = &clock;
+  clock.set(kSimStart);
+  ASSERT_TRUE(probe->waitFor([] { return probe->points_.getNumSubscribers() > 0; }, 30.0));
+  probe->spinFor(1.0);
+  for (int k = 0; k < 10; ++k) simScan(kSimStart + 0.1 * k, kSimStart + 0.1 * k);
+  // The clock now advances at half the data's pace, until it is 2 s behind, and stays 2 s behind.
+  double lag = 0.0;
+  for (int k = 10; k < 60; ++k)
+  {
+    lag = std::min(2.0, lag + 0.05);
+    simScan(kSimStart + 0.1 * k, kSimStart + 0.1 * k - lag);
+  }
+  ASSERT_EQ(lag, 2.0);
+  EXPECT_TRUE(probe->waitFor([] { return probe->value("fusion", "scans fused") >= 59.0; }, kSettle))
+      << "fused " << probe->value("fusion", "scans fused") << " of 60";
+  EXPECT_EQ(probe->value("fusion", "tf buffer clears"), 0.0);
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
+  EXPECT_EQ(probe->value("fusion", "scans dropped (future stamp)"), 0.0);
+  EXPECT_EQ(probe->value("fusion", "scans dropped (no transform)"), 0.0);
+  EXPECT_EQ(probe->value("scan_grid", "tf buffer clears (time jump)"), 0.0);
+  EXPECT_EQ(probe->value("scan_grid", "clouds rejected"), 0.0);
+}
+
+TEST(ClockLag, ScansReleasedAfterALongTfGapWithALargeQueueNeverReset)
+{
+  ASSERT_NE(sim_clock, nullptr) << "runs after AClockFallingBehindTheDataClearsAndLosesNothing";
+  double t = sim_data;
+  const auto next = [&t] {
+    t += 0.1;
+    return t;
+  };
+  for (int k = 0; k < 5; ++k)
+  {
+    const double d = next();
+    simScan(d, d - 0.5);
+  }
+  probe->spinFor(0.5);
+  const std::size_t known = probe->knownCells();
+  ASSERT_GT(known, 100u);
+  auto accounted = [] {
+    return probe->value("fusion", "scans fused") + probe->value("fusion", "scans dropped (no transform)") +
+           probe->value("fusion", "scans dropped (out of order)") + probe->value("fusion", "scans dropped (released late)");
+  };
+  const double before = accounted();
+  // 3 s without any transform map <- base_link while the clouds keep coming; then poses again.
+  for (int k = 0; k < 40; ++k)
+  {
+    const double d = next();
+    simScan(d, d - 0.5, k >= 30);
+  }
+  EXPECT_TRUE(probe->waitFor([&] { return accounted() >= before + 39.0; }, kSettle))
+      << "fused or dropped: " << accounted() - before << " of 40";
+  EXPECT_LE(accounted(), before + 40.0);
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0) << "the released scans were read as a time jump";
+  EXPECT_EQ(probe->value("fusion", "tf buffer clears"), 0.0);
+  EXPECT_GE(probe->knownCells(), known * 9 / 10) << "evidence was thrown away";
 }
 
 }  // namespace

@@ -3,9 +3,10 @@
  * @brief Time hygiene of a stream of scans, ROS-free: which scan may be fused, which is dropped, and when
  *        time really jumped back (a looping bag, a restarted `/clock`) so that the MapGrid must start again.
  *
- * Accumulated evidence is only thrown away on a genuine time jump: an out-of-order scan (a second lidar on
- * the same topic, a large cloud that arrives late, scans a tf message filter releases newest first) is
- * dropped and counted; a scan stamped 0 or twice with the same stamp is dropped and counted.
+ * Accumulated evidence is only thrown away on a genuine time jump, when the stamps and the clock both went
+ * back: an out-of-order scan (a second lidar on the same topic, a large cloud that arrives late, scans a tf
+ * message filter releases newest first, even seconds late) is dropped and counted; a scan stamped 0 or twice
+ * with the same stamp is dropped and counted.
  */
 #pragma once
 
@@ -14,6 +15,13 @@
 
 namespace map_aided_fusion {
 namespace core {
+
+/**
+ * Wall seconds after a backward clock jump during which data and transforms stamped ahead of the clock by more than
+ * time_jump_threshold are taken for data of before the jump (in flight when the bag looped) and dropped. Outside
+ * it, data ahead of a lagging clock wait for their transform and are fused, up to future_tolerance.
+ */
+constexpr double kAfterJumpWatch = 5.0;
 
 /// Parameters of StampGuard, ClockJumpDetector and PoseJumpCheck (config/fusion.yaml).
 struct TimeGuardParams
@@ -44,10 +52,12 @@ enum class StampVerdict
   kZeroStamp,   ///< stamped 0 (or negative, or not finite): no pose can be looked up for it
   kDuplicate,   ///< the same stamp as the last fused scan
   kOutOfOrder,  ///< older than the last fused scan by at most time_jump_threshold
-  kTimeJump,    ///< older by more than time_jump_threshold: reset, then fuse
+  kTimeJump,    ///< older by more than time_jump_threshold, no clock to tell otherwise: reset, then fuse
+  kLate,        ///< older by more than time_jump_threshold while a watched clock did not go back (released late)
 };
 
-/// A short name for logs and diagnostics ("fuse", "zero stamp", "duplicate stamp", "out of order", "time jump").
+/// A short name for logs and diagnostics ("fuse", "zero stamp", "duplicate stamp", "out of order", "time jump",
+/// "released late").
 const char* toString(StampVerdict v);
 
 /**
@@ -61,17 +71,44 @@ class StampGuard
 public:
   explicit StampGuard(const TimeGuardParams& params = TimeGuardParams{}) : params_(params) {}
 
-  /// The verdict for a scan stamped @p stamp (seconds).
-  StampVerdict check(double stamp) const;
+  /**
+   * @brief The verdict for a scan stamped @p stamp (seconds).
+   * @param clock_watched true when a ClockJumpDetector watches the clock the stamps come with (ROS time, `/clock`
+   *        under simulated time) and resets this guard on a backward jump. A scan older than the last fused one by
+   *        more than time_jump_threshold is then not a jump (the clock did not go back, or the guard would have
+   *        been reset): it was held back, as by a tf message filter releasing its queue after a transform gap,
+   *        newest first, and is kLate. A clock merely lagging behind the data is not a jump either. Without a
+   *        watched clock (offline replays), stamps alone decide: kTimeJump.
+   */
+  StampVerdict check(double stamp, bool clock_watched = false) const;
   /// Records @p stamp as the last fused scan.
-  void accept(double stamp) { last_ = stamp; }
+  void accept(double stamp)
+  {
+    last_ = stamp;
+    late_since_.reset();
+  }
   /// Forgets the last fused stamp: the next scan is fused whatever its stamp (but 0).
-  void reset() { last_.reset(); }
+  void reset()
+  {
+    last_.reset();
+    late_since_.reset();
+  }
+  /**
+   * @brief Records a kLate verdict at @p wall (seconds, a monotonic clock); true when late scans have kept coming,
+   *        none fused, for more than time_jump_threshold: the source's own time went back (a bag looping on wall
+   *        time, a sensor clock reset), not a queue released after a tf gap (which is over in milliseconds).
+   */
+  bool lateRun(double wall)
+  {
+    if (!late_since_) late_since_ = wall;
+    return wall - *late_since_ > params_.time_jump_threshold;
+  }
   const std::optional<double>& last() const { return last_; }
 
 private:
   TimeGuardParams params_;
   std::optional<double> last_;
+  std::optional<double> late_since_;  ///< wall time of the first kLate since the last fused scan
 };
 
 /**

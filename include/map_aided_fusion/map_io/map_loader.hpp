@@ -161,6 +161,35 @@ struct MapLoadReport
  */
 core::VectorMap loadVectorMap(const MapLoadParams& params, MapLoadReport* report = nullptr);
 
+/// One feature as a reader hands it to the geometry path, in source coordinates (WGS84 longitude and latitude,
+/// or metres in the `map` frame with MapLoadParams::metric).
+struct SourceFeature
+{
+  enum class Kind
+  {
+    kBuilding,
+    kRoadArea,
+    kRoadLine,
+  };
+  Kind kind = Kind::kBuilding;
+  std::string id;                                ///< named in the report's messages
+  std::vector<std::vector<core::Point2>> parts;  ///< polygon: exterior ring then holes (closed or not); line: parts
+  double height = 0.0;                           ///< building height, metres (0: unknown)
+  double width = 0.0;                            ///< road width, metres
+  std::string road_class;                        ///< road class (informational)
+};
+
+/**
+ * @brief The geometry path of loadVectorMap() on features given in memory, without a file or a GDAL driver:
+ *        coordinate checks, vertex limits, hole and validity repair, projection, origin and range checks.
+ *
+ * Used by the in-memory fuzz target (fuzz/fuzz_map_geometry.cpp) and by tests; the attribute and layer
+ * parameters of @p params are not used (the features carry their kind, height and width).
+ * @throws MapLoadError, core::ParameterError as loadVectorMap().
+ */
+core::VectorMap buildVectorMap(const std::vector<SourceFeature>& features, const MapLoadParams& params,
+                               MapLoadReport* report = nullptr);
+
 /// One-paragraph human-readable summary of a report (for logs and the command-line tool).
 std::string summary(const MapLoadReport& report);
 

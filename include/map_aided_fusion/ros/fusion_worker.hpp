@@ -39,6 +39,7 @@ struct FusionCounters
   std::size_t future_stamp = 0;         ///< scans stamped further ahead of the clock than future_tolerance
   std::size_t out_of_order = 0;         ///< scans older than the last fused one (within time_jump_threshold)
   std::size_t duplicate = 0;            ///< scans with the stamp of the last fused one
+  std::size_t late = 0;                 ///< scans older by more than time_jump_threshold, the clock not gone back
   std::size_t resets = 0;               ///< grid resets (genuine time jumps only)
   std::size_t tf_clears = 0;            ///< tf buffer cleared (time jump, or transforms ahead of the clock)
   std::size_t pose_jumps = 0;           ///< vehicle moved faster than max_plausible_speed between two scans
@@ -54,7 +55,7 @@ struct FusionNodeParams
   std::string map_frame = "map";        ///< fixed frame of the MapGrid and the PriorGrid
   std::string base_frame = "base_link"; ///< vehicle frame (informational)
   int tf_queue_size = 5;                ///< scans waiting for their transform, [1, 1000]
-  double future_tolerance = 1.0;        ///< s a scan may be stamped ahead of the clock, [0, 3600]
+  double future_tolerance = 10.0;       ///< s a scan may be stamped ahead of a lagging clock, [0, 3600]
   bool publish_free_cells = false;      ///< also draw free cells in `cells`
   double object_box_height = 1.5;       ///< m, height of the object boxes, (0, 100]
   /// Topic of the vehicle's pose covariance ("" : none, the MapGrid's position_sigma is used).
@@ -74,9 +75,11 @@ struct FusionNodeParams
  * `decision`, `navigable`, `cells`, `objects`.
  *
  * Time: scans are fused in stamp order. A scan stamped 0, further ahead of the clock than
- * future_tolerance, with the stamp of the last fused one, or older than it by at most time_jump_threshold
- * is dropped and counted; only a genuine time jump (a scan older by more than that, or ROS time going back
- * by more than that, as when a bag loops) resets the MapGrid, once, and clears the tf buffer. Diagnostics
+ * future_tolerance, with the stamp of the last fused one, or older than it (released late after a tf gap) is
+ * dropped and counted; only a genuine time jump (ROS time going back by more than time_jump_threshold, as when
+ * a bag loops, or late scans that keep coming for longer than that, none fused) resets the MapGrid, once, and
+ * clears the tf buffer. A clock that lags behind the data is not a
+ * jump: the scans wait for their transforms and are fused. Diagnostics
  * are published on a wall timer and describe the last diagnostic_window seconds.
  */
 class FusionWorker
@@ -124,6 +127,7 @@ private:
   core::StampGuard stamp_guard_;
   core::ClockJumpDetector clock_jump_;
   std::optional<core::Pose2> last_pose_;
+  double last_jump_wall_ = -1e9;  ///< steady time of the last reset for a time jump
   std::string last_scan_frame_;
   FusionCounters counters_;
   core::SlidingCounter fused_window_, lost_window_;

@@ -12,6 +12,7 @@
  */
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -28,6 +29,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "map_aided_fusion/ScanGridConfig.h"
+#include "map_aided_fusion/core/input_health.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/core/sliding_window.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
@@ -41,9 +43,11 @@ struct ScanGridNodeParams
   std::string base_frame = "base_link";  ///< frame of the published grids
   int input_queue_size = 2;              ///< clouds buffered by the subscriber (≥ 1)
   int tf_queue_size = 10;                ///< clouds waiting for their transform (≥ 1)
-  double future_tolerance = 1.0;         ///< s a cloud may be stamped ahead of the clock, [0, 3600]
+  /// s a cloud may be stamped ahead of the clock (a late /clock is waited for), [0, 3600]
+  double future_tolerance = 10.0;
   double time_jump_threshold = 1.0;      ///< s ROS time must go back by to count as a jump (tf buffer cleared)
   core::StreamHealthParams health;       ///< diagnostic period, window and staleness
+  core::InputHealthParams input;         ///< blind clouds and lost inputs
   core::ScanGridParams model;            ///< sensor model and grid, see core::ScanGridParams
   std::string deskew_fixed_frame = "map";  ///< frame the vehicle moves in, for the sweep's motion (odom on a vehicle)
   std::string deskew_time_field = "auto";  ///< per-point time field, or auto (see knownTimeFields())
@@ -62,7 +66,7 @@ struct ScanGridNodeCounters
 {
   std::size_t clouds_received = 0;
   std::size_t clouds_published = 0;
-  std::size_t clouds_rejected = 0;    ///< unreadable, no transform, or bad transform
+  std::size_t clouds_rejected = 0;    ///< unreadable, no transform, bad transform, or blind
   std::size_t clouds_skipped = 0;     ///< nobody subscribed
   std::size_t points_rejected = 0;    ///< invalid returns in processed clouds (see core::ScanGridStats)
   std::map<std::string, std::size_t> rejections;  ///< clouds rejected, by reason
@@ -88,6 +92,8 @@ private:
   void onReconfigure(ScanGridConfig& config, std::uint32_t level);
   void checkClock();
   void reject(const std::string& reason, const std::string& detail);
+  /// True (counted, not fused) when the cloud has too few valid returns. Caller holds mutex_.
+  bool blindCloud(const core::ScanGridStats& stats);
   /// A view of the cloud's x, y, z; false (rejected and counted) when the cloud cannot be read. Caller holds mutex_.
   bool viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCloudView& view);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -117,7 +123,16 @@ private:
   double last_published_wall_ = 0.0;
   core::ScanGridStats last_stats_;
   core::ClockJumpDetector clock_jump_;
+  /// Steady time of the last backward clock jump (clouds ahead of the clock soon after it are of before it).
+  double last_jump_wall_ = -1e9;
   std::size_t tf_clears_ = 0;
+  core::BlindSpell blind_;
+  std::string last_blind_reason_;
+  core::InputGapCounter gaps_;
+  core::SlidingCounter lost_window_, overrun_window_, stream_gap_window_;
+  std::size_t clouds_lost_ = 0, overruns_ = 0;
+  std::size_t stream_gaps_ = 0;           ///< clouds missing from the stream while the node was idle (paused, skipped)
+  std::atomic<double> last_callback_end_{ 0.0 };  ///< steady time the last `points` callback returned
   std::size_t reconfigure_refused_ = 0;
   std::string last_reconfigure_ = "none";
 
