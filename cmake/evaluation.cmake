@@ -29,6 +29,10 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_kitti_replay map_aided_fusion_eval map_aided_fusion_dataset_ros ${catkin_LIBRARIES}
     ${GTEST_LIBRARIES})
   target_compile_definitions(test_kitti_replay PRIVATE MAF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
+  set(_maf_tools_xml "${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-tools.xml")
+  catkin_run_tests_target("pytest" "tools" "pytest-tools.xml"
+    COMMAND "env MAF_BIN=${CATKIN_DEVEL_PREFIX}/lib/${PROJECT_NAME} PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest -q -p no:cacheprovider -rs --junitxml=${_maf_tools_xml} ${CMAKE_CURRENT_SOURCE_DIR}/test/tools ${CMAKE_CURRENT_SOURCE_DIR}/test/package"
+    DEPENDENCIES simulate evaluate)
   add_dependencies(tests kitti_to_bag simulate evaluate map_aided_fusion_fusion_nodelet map_aided_fusion_scan_grid_nodelet
     map_aided_fusion_prior_grid_nodelet)
 endif()

@@ -8,21 +8,9 @@ target_include_directories(map_aided_fusion_core SYSTEM PRIVATE ${PCL_INCLUDE_DI
 target_link_libraries(map_aided_fusion_core ${PCL_COMMON_LIBRARIES} ${PCL_SAMPLE_CONSENSUS_LIBRARIES}
   ${PCL_SEGMENTATION_LIBRARIES})
 
-# pcl_ros filter nodelets (launch/pcl_filters.launch). Debian's pcl_ros declares them in lib/libpcl_ros_filters,
-# which pluginlib looks for in <prefix>/lib of each CMAKE_PREFIX_PATH entry, while the library is in the multiarch
-# folder: a link in the devel space's lib/ lets a manager load pcl/CropBox and pcl/VoxelGrid.
-find_library(MAF_PCL_ROS_FILTERS pcl_ros_filters)
-if(MAF_PCL_ROS_FILTERS)
-  file(MAKE_DIRECTORY ${CATKIN_DEVEL_PREFIX}/lib)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E create_symlink ${MAF_PCL_ROS_FILTERS}
-                  ${CATKIN_DEVEL_PREFIX}/lib/libpcl_ros_filters.so)
-  # The same link in an install space (catkin_make install).
-  install(CODE "file(MAKE_DIRECTORY \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/lib\")
-    execute_process(COMMAND \"${CMAKE_COMMAND}\" -E create_symlink \"${MAF_PCL_ROS_FILTERS}\"
-                    \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/lib/libpcl_ros_filters.so\")")
-else()
-  message(WARNING "pcl_ros filters library not found: launch/pcl_filters.launch will not load (scripts/common.sh)")
-endif()
+# pcl_ros filter nodelets (launch/pcl_filters.launch): the launch file runs their manager through
+# scripts/with_pcl_ros_filters, which lets pluginlib find Debian's library; nothing of pcl_ros is linked or installed.
+install(PROGRAMS scripts/with_pcl_ros_filters DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/scripts)
 
 # Nodelet library (name fixed by nodelet_plugins.xml) and its worker, shared with the plain node.
 add_library(map_aided_fusion_scan_grid_nodelet

@@ -25,6 +25,7 @@ MAF_DEB_PACKAGES=(
   libgtest-dev libbenchmark-dev
   libpcl-dev libpcl-ros-dev libpcl-ros-filters0d libpcl-ros-filter1d tf2-tools
   libtbb-dev python3-yaml python3-optuna python3-psycopg2 python3-pytest postgresql
+  python3-rospy python3-tf2-ros python3-numpy
 )
 
 maf_log() { printf '\033[1m[map_aided_fusion]\033[0m %s\n' "$*" >&2; }

@@ -30,6 +30,8 @@ constexpr std::size_t kShiftRows = 16;         // window rows per chunk of a shi
 constexpr double kMinBudgetMb = 1.0;
 constexpr double kMaxBudgetMb = 1048576.0;
 constexpr double kBytesPerMb = 1048576.0;
+/// Upper bound of the object shape limits (m).
+constexpr double kMaxObjectExtent = 1000.0;
 /// Largest obstacle_clearance, m.
 constexpr double kMaxObstacleClearance = 5.0;
 
@@ -107,6 +109,11 @@ void MapGridParams::validate() const
   validateThreads("threads", threads);
   if (motion_max_cells < 1) throw ParameterError("motion_max_cells", "must be at least 1");
   if (min_object_cells < 1) throw ParameterError("min_object_cells", "must be at least 1");
+  requireInRange("max_object_length", max_object_length, std::numeric_limits<double>::min(), kMaxObjectExtent);
+  requireInRange("max_object_area", max_object_area, std::numeric_limits<double>::min(),
+                 kMaxObjectExtent * kMaxObjectExtent);
+  requireInRange("thin_structure_width", thin_structure_width, 0.0, kMaxObjectExtent);
+  requireInRange("thin_structure_length", thin_structure_length, std::numeric_limits<double>::min(), kMaxObjectExtent);
   fusion.validate();
 }
 
@@ -406,8 +413,9 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
 }
 
 std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<std::int8_t>& decision,
-                                       const PignisticPlanes& betp, int min_cells)
+                                       const PignisticPlanes& betp, const MapGridParams& params)
 {
+  const int min_cells = params.min_object_cells;
   std::vector<GridObject> objects;
   std::vector<std::uint8_t> seen(decision.size(), 0);
   std::vector<std::size_t> stack, region;
@@ -456,6 +464,10 @@ std::vector<GridObject> extractObjects(const GridGeometry& g, const std::vector<
     }
     o.length = hi_u - lo_u + g.resolution;
     o.width = hi_v - lo_v + g.resolution;
+    const double area = n * g.resolution * g.resolution;
+    if (o.length > params.max_object_length || area > params.max_object_area) continue;
+    if (cls == CellClass::kStopped && o.width <= params.thin_structure_width && o.length > params.thin_structure_length)
+      continue;
     objects.push_back(o);
   }
   return objects;

@@ -8,6 +8,10 @@
 namespace map_aided_fusion {
 namespace map_io {
 
+namespace {
+constexpr double kMaxVehicleDistance = 1e7;  // m
+}  // namespace
+
 void PriorGridParams::validate() const
 {
   map.validate();
@@ -21,6 +25,7 @@ void PriorGridParams::validate() const
   if (!std::isfinite(publish_centre_x)) throw core::ParameterError("publish_centre_x", "must be finite");
   if (!std::isfinite(publish_centre_y)) throw core::ParameterError("publish_centre_y", "must be finite");
   core::requireInRange("max_published_cells", max_published_cells, 1.0, 1e9);
+  core::requireInRange("max_vehicle_distance", max_vehicle_distance, 0.0, kMaxVehicleDistance);
 }
 
 namespace {

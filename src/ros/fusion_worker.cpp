@@ -107,6 +107,7 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
     tracks_pub_ = nh_.advertise<TrackedObjectArray>("tracks", 1);
     tracks_markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("tracks/markers", 1);
   }
+  refuseUnknownParams(pnh_, reconfigureNames<FusionConfig>());
 
   const auto queue = static_cast<uint32_t>(node_params_.tf_queue_size);
   scan_filter_ =
@@ -265,6 +266,7 @@ void FusionWorker::onScanDropped(const EvidentialGrid::ConstPtr& msg, tf2_ros::F
 {
   std::lock_guard<std::mutex> lock(mutex_);
   countLost(counters_.dropped_no_transform);
+  dropped_frame_ = msg->header.frame_id;
   ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan at " << msg->header.stamp << " dropped: " << reasonName(reason)
                                                              << " (" << node_params_.map_frame << " <- "
                                                              << msg->header.frame_id << "); "
@@ -580,7 +582,7 @@ void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWind
   if (objects_pub_.getNumSubscribers() > 0)
   {
     auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
-    const auto objects = core::extractObjects(grid.geometry(), decision, betp, grid_.params().min_object_cells);
+    const auto objects = core::extractObjects(grid.geometry(), decision, betp, grid_.params());
     Visualization::objectsToMarkers(objects, header, node_params_.object_box_height, *markers);
     objects_pub_.publish(markers);
   }
@@ -622,7 +624,21 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   const std::size_t fused = fused_window_.count(now);
   const std::size_t lost = lost_window_.count(now);
   const double last = counters_.fused > 0 ? last_fused_wall_ : now;
-  const core::HealthSummary summary = core::streamHealth(h, counters_.fused > 0, now - last, fused, lost, "scans fused");
+  core::HealthSummary summary = core::streamHealth(h, counters_.fused > 0, now - last, fused, lost, "scans fused");
+  if (counters_.fused == 0)
+  {
+    // Say what is waited for: the scan grid topic, or the transform of the scans that came.
+    if (counters_.dropped_no_transform == 0)
+      summary.message = "no scan fused yet: waiting for " + scan_sub_.getTopic() + " (" +
+                        std::to_string(scan_sub_.getNumPublishers()) + " publishers)";
+    else
+      summary.message = "no scan fused yet: " + std::to_string(counters_.dropped_no_transform) +
+                        " dropped for want of the transform " + node_params_.map_frame + " <- " +
+                        (dropped_frame_.empty() ? std::string("the scans' frame") : dropped_frame_) +
+                        " (is the localisation publishing tf?)";
+    if (now - start_wall_ >= h.stale_error && counters_.dropped_no_transform > 0)
+      summary.level = core::HealthLevel::kError;
+  }
   status.summary(static_cast<unsigned char>(summary.level), summary.message);
   status.add("scan rate [Hz]", fused_window_.rate(now, start_wall_));
   status.add("scans fused in window", fused);

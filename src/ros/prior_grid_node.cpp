@@ -25,6 +25,7 @@ constexpr std::size_t kMaxLoggedSkips = 10;
 constexpr double kOutlineWidth = 0.2;  // metres
 constexpr int kQueueSize = 1;
 constexpr double kDiagnosticPeriod = 1.0;  // s, wall time
+constexpr double kVehicleCheckPeriod = 1.0;  // s, wall time, between looks at where the vehicle is
 
 struct Rgba
 {
@@ -101,8 +102,11 @@ PriorGridNode::PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
   diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   diagnostics_->setHardwareID("map_loader");
   diagnostics_->add("PriorGrid", this, &PriorGridNode::diagnose);
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh_);
   load();
   diagnostics_->force_update();
+  vehicle_timer_ = nh_.createWallTimer(ros::WallDuration(kVehicleCheckPeriod),
+                                       [this](const ros::WallTimerEvent&) { checkVehicle(); });
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticPeriod),
                                            [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
 }
@@ -110,7 +114,13 @@ PriorGridNode::PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
 void PriorGridNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (loaded_)
+  if (loaded_ && vehicle_far_)
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "the vehicle is " + std::to_string(static_cast<long>(vehicle_distance_)) +
+                       " m from the nearest map data (max_vehicle_distance " +
+                       std::to_string(static_cast<long>(params_.max_vehicle_distance)) +
+                       " m): the prior does not cover it; wrong map, origin or frame?");
+  else if (loaded_)
     status.summary(report_.skipped_geometries > 0 ? diagnostic_msgs::DiagnosticStatus::WARN :
                                                     diagnostic_msgs::DiagnosticStatus::OK,
                    report_.skipped_geometries > 0 ? "published; some geometries skipped (see the counts)" :
@@ -118,6 +128,7 @@ void PriorGridNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   else
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "nothing published: " + status_);
   status.add("file", report_.file);
+  status.add("vehicle distance to the map data [m]", vehicle_distance_);
   status.add("driver", report_.driver);
   status.add("loads", loads_);
   status.add("last load", status_);
@@ -156,6 +167,7 @@ bool PriorGridNode::load()
   try
   {
     map_io::PriorGridParams params = readPriorGridParams(pnh_);
+    refuseUnknownParams(pnh_);
     params.validate();
     ++loads_;
     report_ = map_io::MapLoadReport{};
@@ -166,6 +178,9 @@ bool PriorGridNode::load()
       ROS_WARN_STREAM("prior_grid: skipped " << report_.messages[i]);
     publish(params, map);
     loaded_ = true;
+    map_ = map;
+    params_ = params;
+    vehicle_far_ = false;
   }
   catch (const core::ParameterError& e)
   {
@@ -182,6 +197,33 @@ bool PriorGridNode::load()
   malloc_trim(0);  // the vector map and the previous grid are freed: give the pages back (a huge map, then a small one)
 #endif
   return loaded_;
+}
+
+void PriorGridNode::checkVehicle()
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!loaded_ || params_.max_vehicle_distance <= 0.0) return;
+  geometry_msgs::TransformStamped t;
+  try
+  {
+    t = tf_buffer_.lookupTransform(params_.frame_id, params_.vehicle_frame, ros::Time(0));
+  }
+  catch (const tf2::TransformException&)
+  {
+    return;  // no localisation yet: nothing to say
+  }
+  const core::Point2 at{ t.transform.translation.x, t.transform.translation.y };
+  vehicle_distance_ = core::distanceToMapData(map_, at);
+  const bool far = vehicle_distance_ > params_.max_vehicle_distance;
+  if (far && !vehicle_far_)
+    ROS_WARN("prior_grid: the vehicle (%s at %.0f, %.0f in %s) is %.0f m from the nearest data of %s "
+             "(max_vehicle_distance %.0f m): the prior does not cover it. Wrong map, origin (origin_latitude, "
+             "origin_longitude) or frame?",
+             params_.vehicle_frame.c_str(), at.x, at.y, params_.frame_id.c_str(), vehicle_distance_,
+             report_.file.c_str(), params_.max_vehicle_distance);
+  else if (!far && vehicle_far_)
+    ROS_INFO("prior_grid: the vehicle is within %.0f m of the map's data again", params_.max_vehicle_distance);
+  vehicle_far_ = far;
 }
 
 void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::VectorMap& map)

@@ -11,6 +11,7 @@
 #include "map_aided_fusion/ros/conversions.hpp"
 #include "map_aided_fusion/ros/param_loading.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
+#include "map_aided_fusion/ros/startup_failure.hpp"
 #include "map_aided_fusion/ros/tf_helpers.hpp"
 
 namespace map_aided_fusion {
@@ -84,12 +85,14 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   try
   {
     params_ = ScanGridNodeParams::load(pnh_);
+    refuseUnknownParams(pnh_, reconfigureNames<ScanGridConfig>());
     builder_.configure(params_.model, Eigen::Isometry3d::Identity());
   }
   catch (const core::ParameterError& e)
   {
     ROS_ERROR("scan_grid: invalid parameter %s/%s; the node stays idle until restarted with valid parameters",
               pnh_.getNamespace().c_str(), e.what());
+    failure_ = std::make_unique<StartupFailure>(nh_, pnh_, "ScanGrid", std::string("invalid parameter ") + e.what());
     return;
   }
   grid_.reset(builder_.geometry());
@@ -145,6 +148,7 @@ void ScanGridWorker::reject(const std::string& reason, const std::string& detail
   ++counters_.clouds_rejected;
   ++counters_.rejections[reason];
   rejected_window_.add(core::steadySeconds());
+  last_rejection_ = reason + ": " + detail;
   if (reported_.insert(reason).second)
     ROS_ERROR("scan_grid: rejected a cloud on %s (%s): %s. Further clouds rejected for this reason are only "
               "counted (see diagnostics).",
@@ -417,14 +421,29 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   found.blind_reason = last_blind_reason_;
   found.lost = lost_window_.count(now);
   found.overruns = overrun_window_.count(now);
-  const core::HealthSummary h = core::inputHealth(
+  core::HealthSummary h = core::inputHealth(
       core::streamHealth(params_.health, ever, ever ? now - last_published_wall_ : 0.0, published, rejected,
                          "clouds published"),
       params_.health, found);
+  if (!ever)
+  {
+    // Say what is waited for: the topic when nothing came, the cause when everything that came was rejected.
+    const double waited = now - start_wall_;
+    if (counters_.clouds_received == 0)
+      h.message = "no cloud received on " + cloud_sub_.getTopic() + " yet (" +
+                  std::to_string(cloud_sub_.getNumPublishers()) + " publishers): is the lidar on that topic? "
+                  "remap `points`";
+    else if (counters_.clouds_rejected > 0)
+    {
+      h.message = "every cloud on " + cloud_sub_.getTopic() + " rejected, the last for " + last_rejection_;
+      if (waited >= params_.health.stale_error) h.level = core::HealthLevel::kError;
+    }
+  }
   status.summary(static_cast<unsigned char>(h.level), h.message);
   status.add("input rate (Hz)", received_window_.rate(now, start_wall_));
   status.add("output rate (Hz)", published_window_.rate(now, start_wall_));
   status.add("clouds rejected in window", rejected);
+  status.add("last rejection", last_rejection_.empty() ? std::string("none") : last_rejection_);
   status.add("lidar blind for (s)", found.blind_for);
   status.add("clouds lost in the input queue in window", found.lost);
   status.add("clouds lost in the input queue", clouds_lost_);

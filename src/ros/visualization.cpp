@@ -12,7 +12,7 @@ using core::CellClass;
 namespace {
 
 constexpr float kCellHeight = 0.1f;
-constexpr float kLabelSize = 0.8f;
+constexpr float kLabelSize = 1.5f;  // m: readable at the default rviz zoom
 constexpr double kLabelLift = 1.0;
 constexpr double kMinTrackBox = 0.3;     // m, the smallest drawn side of a track's box
 constexpr double kArrowShaft = 0.15;     // m
@@ -125,8 +125,9 @@ void Visualization::objectsToMarkers(const std::vector<core::GridObject>& object
     label.scale.x = label.scale.y = 0.0;
     label.scale.z = kLabelSize;
     label.color.a = 1.0f;
-    char text[64];
-    std::snprintf(text, sizeof text, "%s %.2f", o.cell_class == CellClass::kMoving ? "moving" : "stopped", o.mean_betp);
+    char text[96];
+    std::snprintf(text, sizeof text, "%s, BetP %.2f, %.1f x %.1f m",
+                  o.cell_class == CellClass::kMoving ? "moving" : "stopped", o.mean_betp, o.length, o.width);
     label.text = text;
     out.markers.push_back(label);
     ++id;

@@ -511,7 +511,7 @@ TEST(MapGridScene, CarCrossingIsMovingAndLeavesNoTrail)
     }
   }
   const auto o = outputs(mg);
-  const auto objects = extractObjects(mg.geometry(), o.decision, o.betp, mg.params().min_object_cells);
+  const auto objects = extractObjects(mg.geometry(), o.decision, o.betp, mg.params());
   int moving = 0;
   for (const auto& obj : objects)
     if (obj.cell_class == CellClass::kMoving)
@@ -690,7 +690,7 @@ TEST(Objects, ConnectedRegionsWithExtentAndClass)
       betp.p[3][g.index(x, y)] = 0.6f;
     }
   decision[g.index(0, 7)] = static_cast<std::int8_t>(CellClass::kMoving);  // a single cell: noise
-  const auto objects = extractObjects(g, decision, betp, 3);
+  const auto objects = extractObjects(g, decision, betp, MapGridParams{});
   ASSERT_EQ(objects.size(), 2u);
   const auto& car = objects[0].cell_class == CellClass::kMoving ? objects[0] : objects[1];
   const auto& bus = objects[0].cell_class == CellClass::kMoving ? objects[1] : objects[0];
@@ -707,6 +707,42 @@ TEST(Objects, ConnectedRegionsWithExtentAndClass)
   EXPECT_NEAR(bus.width, 2.0, 1e-9);
   EXPECT_NEAR(bus.centroid.x, 8.0, 1e-9);
   EXPECT_NEAR(bus.centroid.y, 5.5, 1e-9);
+}
+
+TEST(Objects, WallsFencesAndHugeRegionsAreNotObjects)
+{
+  const GridGeometry g{ 0.5, 100, 100, 0.0, 0.0 };
+  std::vector<std::int8_t> decision(g.numCells(), static_cast<std::int8_t>(CellClass::kFree));
+  PignisticPlanes betp;
+  for (auto& p : betp.p) p.assign(g.numCells(), 0.5f);
+  const auto fill = [&](int x0, int y0, int x1, int y1, CellClass c) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) decision[g.index(x, y)] = static_cast<std::int8_t>(c);
+  };
+  fill(2, 2, 22, 3, CellClass::kStopped);    // a fence: 10 m x 0.5 m
+  fill(2, 10, 52, 12, CellClass::kStopped);  // a wall: 25 m x 1 m
+  fill(60, 60, 80, 80, CellClass::kStopped); // a 10 m x 10 m block: 100 m^2
+  fill(2, 30, 11, 34, CellClass::kStopped);  // a parked car: 4.5 m x 2 m
+  fill(2, 40, 24, 41, CellClass::kMoving);   // a moving bus seen side-on: 11 m x 0.5 m, moving: kept
+  fill(30, 30, 40, 31, CellClass::kStopped); // a parked car seen side-on: 5 m x 0.5 m, kept
+  MapGridParams p;
+  const auto objects = extractObjects(g, decision, betp, p);
+  ASSERT_EQ(objects.size(), 3u);
+  for (const auto& o : objects) EXPECT_LE(o.length, 11.0 + 1e-9);
+  // The limits are parameters: without them every region is an object.
+  p.max_object_length = p.max_object_area = 1000.0;
+  p.thin_structure_width = 0.0;
+  EXPECT_EQ(extractObjects(g, decision, betp, p).size(), 6u);
+  p.max_object_area = -1.0;
+  try
+  {
+    p.validate();
+    FAIL() << "max_object_area -1 accepted";
+  }
+  catch (const ParameterError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("max_object_area"), std::string::npos);
+  }
 }
 
 TEST(MapGridParams, CombinationRuleIsAParameterNamedInErrors)

@@ -235,6 +235,22 @@ TEST(PriorGrid, BlocksGiveExactClassCounts)
   EXPECT_EQ(grid.bytes(), 1600u);
 }
 
+TEST(VectorMap, DistanceToTheNearestDataIsToEdgesAndLinesNotVertices)
+{
+  VectorMap m;
+  EXPECT_TRUE(std::isinf(distanceToMapData(m, { 0.0, 0.0 })));
+  Building b;
+  b.footprint.outer = rect(0.0, 0.0, 10.0, 10.0);
+  m.buildings.push_back(b);
+  EXPECT_DOUBLE_EQ(distanceToMapData(m, { 5.0, 13.0 }), 3.0);   // above the top edge, far from its vertices
+  EXPECT_DOUBLE_EQ(distanceToMapData(m, { 5.0, 5.0 }), 5.0);    // inside: to the nearest edge
+  EXPECT_DOUBLE_EQ(distanceToMapData(m, { -3.0, -4.0 }), 5.0);  // to a corner
+  RoadLine road;
+  road.points = { { 100.0, -1000.0 }, { 100.0, 1000.0 } };  // 2 km of straight road, two vertices
+  m.road_lines.push_back(road);
+  EXPECT_DOUBLE_EQ(distanceToMapData(m, { 130.0, 0.0 }), 30.0);
+}
+
 TEST(PriorGrid, ASmallMapAfterAHugeOneGivesTheMemoryBack)
 {
   // The map loader reloads into the same grid: its buffers must follow the new map, not stay at the peak.

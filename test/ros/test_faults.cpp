@@ -55,7 +55,11 @@ public:
       auto endsWith = [&](const std::string& tail) {
         return s.name.size() >= tail.size() && s.name.compare(s.name.size() - tail.size(), tail.size(), tail) == 0;
       };
-      const std::string who = endsWith(": fusion")    ? "fusion" :
+      const auto has = [&](const char* part) { return s.name.find(part) != std::string::npos; };
+      const std::string who = has("fusion_huge")     ? "fusion_huge" :
+                              has("fusion_typo")     ? "fusion_typo" :
+                              has("scan_grid_wrong") ? "scan_grid_wrong" :
+                              endsWith(": fusion")    ? "fusion" :
                               endsWith(": ScanGrid")  ? "scan_grid" :
                               endsWith(": PriorGrid") ? "prior_grid" :
                                                         "";
@@ -343,6 +347,10 @@ TEST(Faults, Item7_HugeWindowIsRefusedAndTheManagerKeepsWorking)
       << "the huge nodelet was not loaded";
   EXPECT_FALSE(ros::service::exists("/map_aided_fusion/fusion_huge/set_parameters", false))
       << "the huge fusion nodelet started";
+  // It says why on /diagnostics, under its own name.
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion_huge") == diagnostic_msgs::DiagnosticStatus::ERROR; },
+                             kSettle));
+  EXPECT_NE(probe->message("fusion_huge").find("memory_budget_mb"), std::string::npos) << probe->message("fusion_huge");
   const double fused = probe->value("fusion", "scans fused");
   drive(5);
   EXPECT_GE(probe->value("fusion", "scans fused"), fused + 4.0) << "the manager stopped fusing";
@@ -530,6 +538,65 @@ TEST(BagLoop, ThreeLoopsResetOnceEachAndLoseNoScan)
   EXPECT_GE(probe->messages("fusion"), n + 2) << "diagnostics stopped";
   EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion") != diagnostic_msgs::DiagnosticStatus::OK; }, 4.0))
       << "OK while nothing is fused: " << probe->message("fusion");
+}
+
+TEST(Faults, Item15_EveryMistakeNamesItsCause)
+{
+  setUpPipeline();
+  // A misspelt key: refused, named, with the key meant.
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion_typo") == diagnostic_msgs::DiagnosticStatus::ERROR; },
+                             kSettle));
+  EXPECT_NE(probe->message("fusion_typo").find("decision_treshold"), std::string::npos) << probe->message("fusion_typo");
+  EXPECT_NE(probe->message("fusion_typo").find("did you mean 'decision_threshold'"), std::string::npos)
+      << probe->message("fusion_typo");
+  EXPECT_FALSE(ros::service::exists("/map_aided_fusion/fusion_typo/set_parameters", false));
+  // A ScanGrid waiting on a topic nobody publishes says which.
+  EXPECT_TRUE(probe->waitFor(
+      [] { return probe->message("scan_grid_wrong").find("no cloud received on /no_such_points") != std::string::npos; },
+      kSettle))
+      << probe->message("scan_grid_wrong");
+  // Clouds in a frame tf does not know: ERROR naming the frames once every cloud was rejected for stale_error.
+  ros::NodeHandle nh;
+  ros::Publisher wrong = nh.advertise<sensor_msgs::PointCloud2>("/no_such_points", 5);
+  const boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)> ignore = [](const auto&) {};
+  ros::Subscriber out = nh.subscribe<nav_msgs::OccupancyGrid>("/map_aided_fusion/scan_grid_wrong/occupancy", 1, ignore);
+  ASSERT_TRUE(probe->waitFor([&] { return wrong.getNumSubscribers() > 0 && out.getNumPublishers() > 0; }, 10.0));
+  for (int k = 0; k < 20; ++k)
+  {
+    wrong.publish(makeCloud({}, ros::Time::now(), "nowhere"));
+    probe->spinFor(kScanPeriod);
+  }
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("scan_grid_wrong") == diagnostic_msgs::DiagnosticStatus::ERROR; },
+                             kSettle + 3.0))
+      << probe->message("scan_grid_wrong");
+  EXPECT_NE(probe->message("scan_grid_wrong").find("nowhere"), std::string::npos) << probe->message("scan_grid_wrong");
+  EXPECT_NE(probe->message("scan_grid_wrong").find("every cloud on /no_such_points rejected"), std::string::npos)
+      << probe->message("scan_grid_wrong");
+}
+
+TEST(Faults, Item14_AVehicleFarFromTheMapIsReportedByTheMapLoader)
+{
+  setUpPipeline();
+  probe->sendPose(ros::Time::now());
+  EXPECT_TRUE(probe->waitFor([] { return probe->value("prior_grid", "vehicle distance to the map data [m]") >= 0.0 &&
+                                         probe->level("prior_grid") == diagnostic_msgs::DiagnosticStatus::OK; },
+                             kSettle))
+      << probe->message("prior_grid");
+  // 5 km east of the town (the localisation in another frame, a wrong origin).
+  for (int k = 0; k < 15; ++k)
+  {
+    probe->sendPose(ros::Time::now(), 5000.0);
+    probe->spinFor(kScanPeriod);
+  }
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("prior_grid") == diagnostic_msgs::DiagnosticStatus::WARN; },
+                             kSettle));
+  EXPECT_NE(probe->message("prior_grid").find("from the nearest map data"), std::string::npos)
+      << probe->message("prior_grid");
+  EXPECT_GT(probe->value("prior_grid", "vehicle distance to the map data [m]"), 4000.0);
+  probe->sendPose(ros::Time::now());  // back in town
+  EXPECT_TRUE(probe->waitFor([] { return probe->level("prior_grid") == diagnostic_msgs::DiagnosticStatus::OK; },
+                             kSettle))
+      << probe->message("prior_grid");
 }
 
 // ------------------------------------------------------------------------------------------------

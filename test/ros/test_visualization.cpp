@@ -71,8 +71,8 @@ TEST(Visualization, ObjectsAreBoxesWithLabels)
   EXPECT_DOUBLE_EQ(box.scale.x, 4.5);
   EXPECT_NEAR(box.pose.orientation.z, std::sqrt(0.5), 1e-12);
   EXPECT_EQ(out.markers[2].type, visualization_msgs::Marker::TEXT_VIEW_FACING);
-  EXPECT_EQ(out.markers[2].text, "moving 0.80");
-  EXPECT_EQ(out.markers[4].text, "stopped 0.65");
+  EXPECT_EQ(out.markers[2].text, "moving, BetP 0.80, 4.5 x 2.0 m");
+  EXPECT_EQ(out.markers[4].text, "stopped, BetP 0.65, 4.5 x 2.0 m");
   EXPECT_NE(out.markers[1].id, out.markers[3].id);
 }
 

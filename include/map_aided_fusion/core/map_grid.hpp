@@ -40,6 +40,14 @@ struct MapGridParams
   double recentre_distance = 5.0;
   double decision_threshold = 0.4;  ///< BetP a class needs to be a cell's decision, in [0, 1]
   int min_object_cells = 3;         ///< smaller connected S or V regions are noise (cells, ≥ 1)
+  /// Longer S or V regions are structure, not an object (m, > 0; an articulated bus is 18.75 m).
+  double max_object_length = 20.0;
+  /// Larger S or V regions are structure, not an object (m², > 0).
+  double max_object_area = 60.0;
+  /// S regions at most this wide (m, ≥ 0) and longer than thin_structure_length are walls or fences, not
+  /// objects (without a map they are S). Moving regions are exempt.
+  double thin_structure_width = 1.0;
+  double thin_structure_length = 8.0;  ///< m, > 0; see thin_structure_width
   /**
    * Memory the MapGrid's window may take, MiB (in [1, 1048576]). A window whose cells would need more
    * (bytesPerCell() each: every stored focal-set plane, ζ, BetP, the prior window, the map doubt, the decision and
@@ -133,6 +141,10 @@ void forEachParam(MapGridParams& p, Get&& get)
   get("moving_expiry", p.fusion.moving_expiry);
   get("decision_threshold", p.decision_threshold);
   get("min_object_cells", p.min_object_cells);
+  get("max_object_length", p.max_object_length);
+  get("max_object_area", p.max_object_area);
+  get("thin_structure_width", p.thin_structure_width);
+  get("thin_structure_length", p.thin_structure_length);
   get("memory_budget_mb", p.memory_budget_mb);
   get("point_occupancy", p.point_occupancy);
   get("motion_share", p.motion_share);
@@ -243,9 +255,13 @@ std::size_t spreadMotion(MapMassGrid& grid, PignisticPlanes& betp, const ScanMas
 void decide(const MapMassGrid& grid, const PignisticPlanes& betp, const MapGridParams& params,
             std::vector<std::int8_t>& out, const Parallel* parallel = nullptr);
 
-/// Connected regions (8-connectivity) of kMoving or kStopped decisions with at least @p min_cells cells.
+/**
+ * @brief Connected regions (8-connectivity) of kMoving or kStopped decisions that are shaped like objects: at least
+ *        min_object_cells cells, at most max_object_length long and max_object_area large, and (stopped) not a thin
+ *        structure (width ≤ thin_structure_width and length > thin_structure_length) — the limits of @p params.
+ */
 std::vector<GridObject> extractObjects(const GridGeometry& geometry, const std::vector<std::int8_t>& decision,
-                                       const PignisticPlanes& betp, int min_cells);
+                                       const PignisticPlanes& betp, const MapGridParams& params);
 
 /**
  * @brief The rolling-window MapGrid and the per-scan pipeline of the paper.

@@ -50,5 +50,11 @@ struct VectorMap
   std::size_t skipped_geometries = 0;  ///< broken or incomplete geometries skipped while loading
 };
 
+/**
+ * @brief Distance (m) from @p p to the nearest data of @p map: the edges of building footprints and road areas
+ *        (outer rings and holes) and the segments of road centre lines. Infinity for an empty map.
+ */
+double distanceToMapData(const VectorMap& map, const Point2& p);
+
 }  // namespace core
 }  // namespace map_aided_fusion

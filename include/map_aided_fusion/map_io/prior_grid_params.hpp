@@ -34,6 +34,10 @@ struct PriorGridParams
   /// that fits, with a warning.
   double max_published_cells = 4.0e6;
   bool publish_outlines = true;     ///< publish prior_grid/outlines (MarkerArray)
+  /// The vehicle's frame: the node warns (once per excursion) and its diagnostics say so when the vehicle is
+  /// farther than max_vehicle_distance from every building, road area and road line of the map.
+  std::string vehicle_frame = "base_link";
+  double max_vehicle_distance = 500.0;  ///< metres, [0, 1e7]; 0: not checked
 
   /// @throws core::ParameterError naming the offending parameter (also validates map and beta).
   void validate() const;
@@ -95,6 +99,8 @@ void forEachPriorGridParam(PriorGridParams& p, Get&& get)
   get("publish_centre_y", p.publish_centre_y);
   get("max_published_cells", p.max_published_cells);
   get("publish_outlines", p.publish_outlines);
+  get("vehicle_frame", p.vehicle_frame);
+  get("max_vehicle_distance", p.max_vehicle_distance);
 }
 
 /**

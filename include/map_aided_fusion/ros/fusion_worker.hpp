@@ -129,6 +129,7 @@ private:
   std::optional<core::Pose2> last_pose_;
   double last_jump_wall_ = -1e9;  ///< steady time of the last reset for a time jump
   std::string last_scan_frame_;
+  std::string dropped_frame_;  ///< frame of the last scan dropped for want of its transform
   FusionCounters counters_;
   core::SlidingCounter fused_window_, lost_window_;
   core::SlidingCounter covariance_rejected_window_;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <ros/node_handle.h>
 
@@ -14,10 +15,14 @@
 
 namespace map_aided_fusion {
 
+/// Records that the component under namespace @p ns knows the parameter @p name (every readParam() does), process-wide.
+void recordKnownParam(const std::string& ns, const std::string& name);
+
 /// @p value keeps its default when @p name is not set; a value of the wrong type is a ParameterError.
 template <typename T>
 void readParam(const ros::NodeHandle& nh, const std::string& name, T& value)
 {
+  recordKnownParam(nh.getNamespace(), name);
   if (!nh.hasParam(name)) return;
   if (!nh.getParam(name, value))
     throw core::ParameterError(name, "has the wrong type (" + nh.resolveName(name) + ")");
@@ -30,6 +35,28 @@ void readParam(const ros::NodeHandle& nh, const std::string& name, double& value
 inline auto parameterServerReader(const ros::NodeHandle& nh)
 {
   return [&nh](const std::string& name, auto& value) { readParam(nh, name, value); };
+}
+
+/**
+ * @brief The keys set under @p pnh's namespace that no readParam() on it asked for and that are not in
+ *        @p also_known (a misspelt `decision_treshold`, a key of another component's file), sorted.
+ */
+std::vector<std::string> unknownParams(const ros::NodeHandle& pnh, const std::vector<std::string>& also_known = {});
+
+/**
+ * @brief Refuses unknown keys (see unknownParams()), as the simulator refuses unknown scenario keys: a key that is
+ *        silently ignored leaves its default in force without anybody knowing.
+ * @throws core::ParameterError naming the first unknown key and the nearest known one.
+ */
+void refuseUnknownParams(const ros::NodeHandle& pnh, const std::vector<std::string>& also_known = {});
+
+/// The parameter names of a dynamic_reconfigure config type (its server writes them into the private namespace).
+template <class Config>
+std::vector<std::string> reconfigureNames()
+{
+  std::vector<std::string> names;
+  for (const auto& d : Config::__getParamDescriptions__()) names.push_back(d->name);
+  return names;
 }
 
 /**

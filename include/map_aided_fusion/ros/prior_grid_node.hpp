@@ -8,6 +8,9 @@
  *          outlines inside the published window).
  *        Service `~reload` (std_srvs/Trigger) re-reads the parameters and the map.
  *
+ * Once a second it looks up the vehicle (vehicle_frame) in frame_id: farther than max_vehicle_distance from all the
+ * map's data, it warns once and its diagnostics go WARN (a wrong map, origin or frame).
+ *
  * Bad parameters or an unreadable map are logged (ROS_ERROR, naming the parameter or the file and the
  * cause) and returned by `~reload`; the node stays alive and publishes nothing new (a previously published
  * prior stays latched).
@@ -21,6 +24,8 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "map_aided_fusion/core/prior_grid.hpp"
 #include "map_aided_fusion/map_io/prior_grid_params.hpp"
@@ -54,6 +59,8 @@ private:
   /// Diagnostics: the file, what was kept and skipped, the published grid and its origin.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void publish(const map_io::PriorGridParams& params, const core::VectorMap& map);
+  /// Where the vehicle is with respect to the map's data (wall timer).
+  void checkVehicle();
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
@@ -68,6 +75,13 @@ private:
   map_io::MapLoadReport report_;
   core::GridGeometry published_;
   std::size_t loads_ = 0;
+  core::VectorMap map_;                  ///< the loaded map, for the vehicle's distance to its data
+  map_io::PriorGridParams params_;       ///< the parameters of the last successful load
+  double vehicle_distance_ = -1.0;       ///< m from the vehicle to the nearest map data; -1: not known
+  bool vehicle_far_ = false;             ///< farther than max_vehicle_distance (warned once per excursion)
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::WallTimer vehicle_timer_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
   ros::WallTimer diagnostics_timer_;
 };

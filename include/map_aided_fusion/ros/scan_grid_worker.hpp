@@ -34,6 +34,7 @@
 #include "map_aided_fusion/core/sliding_window.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
 #include "map_aided_fusion/ros/cloud_deskew.hpp"
+#include "map_aided_fusion/ros/startup_failure.hpp"
 
 namespace map_aided_fusion {
 
@@ -107,6 +108,7 @@ private:
   core::ScanMassGrid grid_;
   ScanGridNodeCounters counters_;
   std::set<std::string> reported_;  // rejection reasons already logged as errors
+  std::string last_rejection_;      // "reason: detail" of the last rejected cloud
   CloudDeskewer deskewer_;
   std::map<std::string, std::size_t> deskew_counts_;  // clouds by deskew status, since start
   std::set<std::string> deskew_warned_;               // skip reasons already warned about
@@ -140,6 +142,7 @@ private:
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> tf_filter_;
   std::unique_ptr<dynamic_reconfigure::Server<ScanGridConfig>> reconfigure_;
+  std::unique_ptr<StartupFailure> failure_;  ///< ERROR diagnostics when the parameters were refused
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   ros::Subscriber cloud_sub_;
   ros::Publisher grid_pub_;
