@@ -1052,7 +1052,11 @@ void MapLoadParams::validate() const
     throw core::ParameterError("building_attribute", "empty, and no building_layer either");
 }
 
-core::VectorMap loadVectorMap(const MapLoadParams& params, MapLoadReport* report)
+namespace {
+
+/// Validates @p params, resets the report (@p report or a local one) and runs @p run on a Loader.
+template <class Run>
+core::VectorMap withLoader(const MapLoadParams& params, MapLoadReport* report, Run&& run)
 {
   params.validate();
   MapLoadReport local;
@@ -1060,7 +1064,14 @@ core::VectorMap loadVectorMap(const MapLoadParams& params, MapLoadReport* report
   r = MapLoadReport{};
   r.file = params.file;
   Loader loader(params, r);
-  return loader.run();
+  return run(loader);
+}
+
+}  // namespace
+
+core::VectorMap loadVectorMap(const MapLoadParams& params, MapLoadReport* report)
+{
+  return withLoader(params, report, [](Loader& loader) { return loader.run(); });
 }
 
 core::VectorMap buildVectorMap(const std::vector<SourceFeature>& features, const MapLoadParams& params,
@@ -1068,13 +1079,7 @@ core::VectorMap buildVectorMap(const std::vector<SourceFeature>& features, const
 {
   MapLoadParams p = params;
   if (p.file.empty()) p.file = "(in memory)";  // named in errors; nothing is opened
-  p.validate();
-  MapLoadReport local;
-  MapLoadReport& r = report != nullptr ? *report : local;
-  r = MapLoadReport{};
-  r.file = p.file;
-  Loader loader(p, r);
-  return loader.run(features);
+  return withLoader(p, report, [&](Loader& loader) { return loader.run(features); });
 }
 
 std::string summary(const MapLoadReport& r)
