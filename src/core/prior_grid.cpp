@@ -323,9 +323,9 @@ void PriorGrid::sampleCoverage(const VectorMap& map, PriorBuildStats& st)
   if (geometry_.width > std::numeric_limits<int>::max() / k || geometry_.height > std::numeric_limits<int>::max() / k)
     throw ParameterError("cell_test", "the grid is too large for the coverage test");
   const std::size_t n = geometry_.numCells();
-  assignFitted(building_samples_, n, std::uint16_t{ 0 });
-  assignFitted(road_samples_, n, std::uint16_t{ 0 });
-  assignFitted(outline_, n, std::uint8_t{ 0 });
+  building_samples_.assign(n, 0);  // released at the start of build(): sized afresh
+  road_samples_.assign(n, 0);
+  outline_.assign(n, 0);
   GridGeometry fine = geometry_;
   fine.resolution = geometry_.resolution / k;
   fine.width = geometry_.width * k;

@@ -292,8 +292,7 @@ void FusionWorker::onScanIn(const EvidentialGrid::ConstPtr& msg)
     if (ahead > node_params_.future_tolerance || (after_jump && ahead > node_params_.time.time_jump_threshold))
     {
       countLost(counters_.future_stamp);
-      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << ", "
-                                                                     << stamp - now.toSec()
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << ", " << ahead
                                                                      << " s ahead of the clock (future_tolerance "
                                                                      << node_params_.future_tolerance << " s"
                                                                      << (after_jump ? ", after a backward clock jump" : "")

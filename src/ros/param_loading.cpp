@@ -39,6 +39,16 @@ std::size_t editDistance(const std::string& a, const std::string& b)
   return row[b.size()];
 }
 
+/// The keys the component under @p pnh asked for, and @p also_known.
+std::set<std::string> knownFor(const ros::NodeHandle& pnh, const std::vector<std::string>& also_known)
+{
+  std::set<std::string> known(also_known.begin(), also_known.end());
+  std::lock_guard<std::mutex> lock(knownMutex());
+  const auto& k = knownKeys()[pnh.getNamespace()];
+  known.insert(k.begin(), k.end());
+  return known;
+}
+
 }  // namespace
 
 void recordKnownParam(const std::string& ns, const std::string& name)
@@ -49,12 +59,7 @@ void recordKnownParam(const std::string& ns, const std::string& name)
 
 std::vector<std::string> unknownParams(const ros::NodeHandle& pnh, const std::vector<std::string>& also_known)
 {
-  std::set<std::string> known(also_known.begin(), also_known.end());
-  {
-    std::lock_guard<std::mutex> lock(knownMutex());
-    const auto& k = knownKeys()[pnh.getNamespace()];
-    known.insert(k.begin(), k.end());
-  }
+  const std::set<std::string> known = knownFor(pnh, also_known);
   std::vector<std::string> names;
   if (!pnh.getParamNames(names)) return {};
   const std::string prefix = pnh.getNamespace() + "/";
@@ -72,15 +77,9 @@ void refuseUnknownParams(const ros::NodeHandle& pnh, const std::vector<std::stri
 {
   const std::vector<std::string> unknown = unknownParams(pnh, also_known);
   if (unknown.empty()) return;
-  std::set<std::string> known(also_known.begin(), also_known.end());
-  {
-    std::lock_guard<std::mutex> lock(knownMutex());
-    const auto& k = knownKeys()[pnh.getNamespace()];
-    known.insert(k.begin(), k.end());
-  }
   std::string hint;
   std::size_t best = std::string::npos;
-  for (const std::string& k : known)
+  for (const std::string& k : knownFor(pnh, also_known))
     if (const std::size_t d = editDistance(unknown.front(), k); d < best)
     {
       best = d;

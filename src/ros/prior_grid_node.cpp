@@ -5,6 +5,7 @@
 #endif
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include <geometry_msgs/Point.h>
@@ -172,13 +173,13 @@ bool PriorGridNode::load()
     ++loads_;
     report_ = map_io::MapLoadReport{};
     report_.file = params.map.file;  // shown even when the load fails early
-    const core::VectorMap map = map_io::loadVectorMap(params.map, &report_);
+    core::VectorMap map = map_io::loadVectorMap(params.map, &report_);
     ROS_INFO_STREAM("prior_grid: " << map_io::summary(report_));
     for (std::size_t i = 0; i < std::min(kMaxLoggedSkips, report_.messages.size()); ++i)
       ROS_WARN_STREAM("prior_grid: skipped " << report_.messages[i]);
     publish(params, map);
     loaded_ = true;
-    map_ = map;
+    map_ = std::move(map);  // kept for the vehicle's distance to the data
     params_ = params;
     vehicle_far_ = false;
   }
