@@ -1,7 +1,7 @@
 # Real labelled datasets: ROS-free KITTI / SemanticKITTI reader, its bag writer, the `kitti_to_bag` tool, tests.
 add_library(map_aided_fusion_dataset src/dataset/kitti.cpp src/dataset/kitti_tracking.cpp)
-target_include_directories(map_aided_fusion_dataset PUBLIC
-  $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> ${EIGEN3_INCLUDE_DIRS})
+target_include_directories(map_aided_fusion_dataset PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+target_link_libraries(map_aided_fusion_dataset Eigen3::Eigen)
 set_target_properties(map_aided_fusion_dataset PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
 add_library(map_aided_fusion_dataset_ros src/ros/kitti_bag.cpp)

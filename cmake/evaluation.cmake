@@ -14,7 +14,6 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_metrics map_aided_fusion_eval)
 endif()
 
-find_package(yaml-cpp REQUIRED)
 add_executable(evaluate src/tools/evaluate.cpp)
 target_link_libraries(evaluate map_aided_fusion_eval map_aided_fusion_map_io map_aided_fusion_scan_grid_nodelet
   map_aided_fusion_dataset_ros

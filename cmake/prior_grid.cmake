@@ -24,13 +24,13 @@ target_sources(map_aided_fusion_core PRIVATE src/core/prior_grid.cpp src/core/pr
 
 # ---- ROS: nodelet (library name fixed by nodelet_plugins.xml) and plain node -------------------------
 add_library(map_aided_fusion_prior_grid_nodelet
-  src/ros/prior_grid_node.cpp
-  src/ros/prior_grid_nodelet.cpp
+  src/ros/prior_grid_worker.cpp
+  src/nodelets/prior_grid_nodelet.cpp
 )
 target_link_libraries(map_aided_fusion_prior_grid_nodelet map_aided_fusion_ros map_aided_fusion_map_io ${catkin_LIBRARIES})
 add_dependencies(map_aided_fusion_prior_grid_nodelet ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 
-add_executable(prior_grid_node src/ros/prior_grid_node_main.cpp)
+add_executable(prior_grid_node src/nodes/prior_grid_node.cpp)
 target_link_libraries(prior_grid_node map_aided_fusion_prior_grid_nodelet)
 
 install(TARGETS map_aided_fusion_prior_grid_nodelet prior_grid_node
@@ -73,7 +73,6 @@ if(TARGET bench_map_aided_fusion)
 endif()
 
 # ---- Command-line tool (ROS-free) -----------------------------------------------------------------
-find_package(yaml-cpp REQUIRED)
 add_executable(prior_grid_tool src/tools/prior_grid_tool.cpp)
 target_link_libraries(prior_grid_tool map_aided_fusion_map_io yaml-cpp)
 install(TARGETS prior_grid_tool RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -9,21 +9,22 @@ target_link_libraries(map_aided_fusion_core ${PCL_COMMON_LIBRARIES} ${PCL_SAMPLE
   ${PCL_SEGMENTATION_LIBRARIES})
 
 # pcl_ros filter nodelets (launch/pcl_filters.launch): the launch file runs their manager through
-# scripts/with_pcl_ros_filters, which lets pluginlib find Debian's library; nothing of pcl_ros is linked or installed.
-install(PROGRAMS scripts/with_pcl_ros_filters DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/scripts)
+# `rosrun map_aided_fusion with_pcl_ros_filters`, which lets pluginlib find Debian's library; nothing of pcl_ros is
+# linked or installed.
+install(PROGRAMS scripts/with_pcl_ros_filters DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # Nodelet library (name fixed by nodelet_plugins.xml) and its worker, shared with the plain node.
 add_library(map_aided_fusion_scan_grid_nodelet
   src/ros/point_cloud_view.cpp
   src/ros/cloud_deskew.cpp
   src/ros/scan_grid_worker.cpp
-  src/ros/scan_grid_nodelet.cpp
+  src/nodelets/scan_grid_nodelet.cpp
 )
 target_link_libraries(map_aided_fusion_scan_grid_nodelet map_aided_fusion_ros map_aided_fusion_core ${catkin_LIBRARIES})
 add_dependencies(map_aided_fusion_scan_grid_nodelet ${PROJECT_NAME}_generate_messages_cpp ${PROJECT_NAME}_gencfg
   ${catkin_EXPORTED_TARGETS})
 
-add_executable(scan_grid_node src/ros/scan_grid_node.cpp)
+add_executable(scan_grid_node src/nodes/scan_grid_node.cpp)
 target_link_libraries(scan_grid_node map_aided_fusion_scan_grid_nodelet)
 
 install(TARGETS map_aided_fusion_scan_grid_nodelet scan_grid_node
@@ -36,7 +37,6 @@ if(TARGET bench_map_aided_fusion)
 endif()
 
 if(CATKIN_ENABLE_TESTING)
-  find_package(yaml-cpp REQUIRED)
   catkin_add_gtest(test_scan_grid
     test/core/test_scan_grid.cpp
     test/core/test_scan_grid_real.cpp

@@ -1,6 +1,4 @@
 # Scenario simulator: ROS-free library (STL + yaml-cpp), rosbag writer, `simulate` tool, tests, benchmarks.
-find_package(yaml-cpp REQUIRED)
-
 add_library(map_aided_fusion_sim
   src/sim/geometry.cpp
   src/sim/scene.cpp

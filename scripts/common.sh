@@ -11,7 +11,7 @@ export PYTHONNOUSERSITE=1
 
 # Debian 12 packages the build, the tests, the benchmarks and the demo need.
 MAF_DEB_PACKAGES=(
-  build-essential cmake catkin
+  build-essential cmake catkin pkg-config
   libroscpp-dev libnodeletlib-dev libnodelet-dev libnodeletlib-tools pluginlib-dev
   libtf2-ros-dev libtf2-dev libtf2-geometry-msgs-dev libtf2-msgs-dev
   libsensor-msgs-dev libnav-msgs-dev libvisualization-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
@@ -24,7 +24,7 @@ MAF_DEB_PACKAGES=(
   libeigen3-dev libgeographiclib-dev libgdal-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev
   libpcl-dev libpcl-ros-dev libpcl-ros-filters0d libpcl-ros-filter1d tf2-tools
-  libtbb-dev python3-yaml python3-optuna python3-psycopg2 python3-pytest postgresql
+  libtbb-dev python3-yaml python3-optuna python3-psycopg2 python3-pytest postgresql catkin-lint
   python3-rospy python3-tf2-ros python3-numpy
 )
 

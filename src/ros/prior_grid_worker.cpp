@@ -1,4 +1,4 @@
-#include "map_aided_fusion/ros/prior_grid_node.hpp"
+#include "map_aided_fusion/ros/prior_grid_worker.hpp"
 
 #ifdef __GLIBC__
 #include <malloc.h>
@@ -93,16 +93,16 @@ map_io::PriorGridParams readPriorGridParams(const ros::NodeHandle& pnh)
   return p;
 }
 
-PriorGridNode::PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh)
+PriorGridWorker::PriorGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh)
 {
   const bool latched = true;
   prior_pub_ = nh_.advertise<EvidentialGrid>("prior_grid", kQueueSize, latched);
   occupancy_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("prior_grid/occupancy", kQueueSize, latched);
   outlines_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("prior_grid/outlines", kQueueSize, latched);
-  reload_srv_ = pnh_.advertiseService("reload", &PriorGridNode::reload, this);
+  reload_srv_ = pnh_.advertiseService("reload", &PriorGridWorker::reload, this);
   diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   diagnostics_->setHardwareID("map_loader");
-  diagnostics_->add("PriorGrid", this, &PriorGridNode::diagnose);
+  diagnostics_->add("PriorGrid", this, &PriorGridWorker::diagnose);
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh_);
   load();
   diagnostics_->force_update();
@@ -112,7 +112,7 @@ PriorGridNode::PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
                                            [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
 }
 
-void PriorGridNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
+void PriorGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
   if (loaded_ && vehicle_far_)
@@ -155,14 +155,14 @@ void PriorGridNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("grid origin [m]", std::to_string(published_.origin_x) + ", " + std::to_string(published_.origin_y));
 }
 
-bool PriorGridNode::reload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res)
+bool PriorGridWorker::reload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res)
 {
   res.success = load();
   res.message = status_;
   return true;
 }
 
-bool PriorGridNode::load()
+bool PriorGridWorker::load()
 {
   std::lock_guard<std::mutex> lock(mutex_);
   try
@@ -200,7 +200,7 @@ bool PriorGridNode::load()
   return loaded_;
 }
 
-void PriorGridNode::checkVehicle()
+void PriorGridWorker::checkVehicle()
 {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!loaded_ || params_.max_vehicle_distance <= 0.0) return;
@@ -227,7 +227,7 @@ void PriorGridNode::checkVehicle()
   vehicle_far_ = far;
 }
 
-void PriorGridNode::publish(const map_io::PriorGridParams& params, const core::VectorMap& map)
+void PriorGridWorker::publish(const map_io::PriorGridParams& params, const core::VectorMap& map)
 {
   const core::GridGeometry extent = core::PriorGrid::extentOf(map, params.resolution, params.margin);
   bool cropped = false;

@@ -1,5 +1,5 @@
 /**
- * @file prior_grid_node.hpp
+ * @file prior_grid_worker.hpp
  * @brief The PriorGrid worker shared by the PriorGridNodelet and the plain prior_grid_node: loads the map
  *        given by the private parameters (config/prior_grid.yaml), rasterises it and publishes, latched:
  *        - `prior_grid` (map_aided_fusion/EvidentialGrid; focal sets B, R, T, Ω; frame `frame_id`),
@@ -42,11 +42,11 @@ constexpr std::int8_t kPriorOccupancyUnknown = -1;
 map_io::PriorGridParams readPriorGridParams(const ros::NodeHandle& pnh);
 
 /// The worker: owns the publishers, the service and the PriorGrid.
-class PriorGridNode
+class PriorGridWorker
 {
 public:
   /// Advertises, loads and publishes (errors are logged, not thrown).
-  PriorGridNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+  PriorGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh);
 
   /// True when the last load succeeded.
   bool loaded() const { return loaded_; }
