@@ -31,7 +31,7 @@ if(CATKIN_ENABLE_TESTING)
   set(_maf_tools_xml "${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-tools.xml")
   catkin_run_tests_target("pytest" "tools" "pytest-tools.xml"
     COMMAND "env MAF_BIN=${CATKIN_DEVEL_PREFIX}/lib/${PROJECT_NAME} PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest -q -p no:cacheprovider -rs --junitxml=${_maf_tools_xml} ${CMAKE_CURRENT_SOURCE_DIR}/test/tools ${CMAKE_CURRENT_SOURCE_DIR}/test/package"
-    DEPENDENCIES simulate evaluate)
+    DEPENDENCIES simulate evaluate parameter_reference)
   add_dependencies(tests kitti_to_bag simulate evaluate map_aided_fusion_fusion_nodelet map_aided_fusion_scan_grid_nodelet
     map_aided_fusion_prior_grid_nodelet)
 endif()

@@ -66,16 +66,7 @@ void FusionNodeParams::validate() const
 FusionNodeParams FusionNodeParams::load(const ros::NodeHandle& pnh)
 {
   FusionNodeParams p;
-  readParam(pnh, "map_frame", p.map_frame);
-  readParam(pnh, "base_frame", p.base_frame);
-  readParam(pnh, "tf_queue_size", p.tf_queue_size);
-  readParam(pnh, "future_tolerance", p.future_tolerance);
-  readParam(pnh, "publish_free_cells", p.publish_free_cells);
-  readParam(pnh, "object_box_height", p.object_box_height);
-  readParam(pnh, "pose_covariance_topic", p.pose_covariance_topic);
-  readParam(pnh, "pose_covariance_type", p.pose_covariance_type);
-  core::forEachParam(p.time, parameterServerReader(pnh));
-  core::forEachParam(p.health, parameterServerReader(pnh));
+  forEachParam(p, parameterServerReader(pnh));
   p.validate();
   return p;
 }

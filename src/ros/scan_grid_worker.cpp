@@ -66,16 +66,7 @@ void ScanGridNodeParams::validate() const
 ScanGridNodeParams ScanGridNodeParams::load(const ros::NodeHandle& pnh)
 {
   ScanGridNodeParams p;
-  readParam(pnh, "base_frame", p.base_frame);
-  readParam(pnh, "input_queue_size", p.input_queue_size);
-  readParam(pnh, "tf_queue_size", p.tf_queue_size);
-  readParam(pnh, "future_tolerance", p.future_tolerance);
-  readParam(pnh, "time_jump_threshold", p.time_jump_threshold);
-  readParam(pnh, "deskew_fixed_frame", p.deskew_fixed_frame);
-  readParam(pnh, "deskew_time_field", p.deskew_time_field);
-  core::forEachParam(p.health, parameterServerReader(pnh));
-  core::forEachParam(p.input, parameterServerReader(pnh));
-  core::forEachParam(p.model, parameterServerReader(pnh));
+  forEachParam(p, parameterServerReader(pnh));
   p.validate();
   return p;
 }

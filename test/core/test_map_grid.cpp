@@ -752,7 +752,7 @@ TEST(MapGridParams, CombinationRuleIsAParameterNamedInErrors)
   EXPECT_STREQ(toString(MapGridParams{}.fusion.rule), "modified_yager") << "the paper's rule by default";
   auto withRule = [](const std::string& name) {
     MapGridParams p;
-    forEachParam(p, [&](const std::string& key, auto& value) {
+    forEachParam(p, [&](const std::string& key, auto& value, const ParamDoc&) {
       if constexpr (std::is_same_v<std::decay_t<decltype(value)>, std::string>)
         if (key == "combination_rule") value = name;
     });

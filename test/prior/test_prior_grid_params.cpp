@@ -79,7 +79,7 @@ TEST(PriorGridParams, ConfigFileAndCodeNameTheSameKeys)
   std::set<std::string> in_yaml, in_code;
   for (const auto& kv : yaml) in_yaml.insert(kv.first.as<std::string>());
   map_io::PriorGridParams p;
-  map_io::forEachPriorGridParam(p, [&](const std::string& name, auto& value) {
+  map_io::forEachPriorGridParam(p, [&](const std::string& name, auto& value, const core::ParamDoc&) {
     in_code.insert(name);
     if (const YAML::Node n = yaml[name]) value = n.as<std::remove_reference_t<decltype(value)>>();
   });
@@ -149,7 +149,7 @@ template <class Params>
 std::map<std::string, std::string> valuesOf(Params p)
 {
   std::map<std::string, std::string> out;
-  core::forEachParam(p, [&](const std::string& name, auto& v) {
+  core::forEachParam(p, [&](const std::string& name, auto& v, const core::ParamDoc&) {
     if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>)
       out[name] = v;
     else
@@ -164,7 +164,7 @@ Params loadFile(const std::string& path)
 {
   const YAML::Node yaml = YAML::LoadFile(path);
   Params p;
-  core::forEachParam(p, [&](const std::string& name, auto& value) {
+  core::forEachParam(p, [&](const std::string& name, auto& value, const core::ParamDoc&) {
     const YAML::Node n = yaml[name];
     EXPECT_TRUE(n) << path << " lacks " << name;
     if (n) value = n.as<std::remove_reference_t<decltype(value)>>();

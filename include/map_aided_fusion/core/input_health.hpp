@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/sliding_window.hpp"
 
 namespace map_aided_fusion {
@@ -44,8 +45,8 @@ struct InputHealthParams
 template <class Get>
 void forEachParam(InputHealthParams& p, Get&& get)
 {
-  get("min_valid_returns", p.min_valid_returns);
-  get("input_period", p.input_period);
+  get("min_valid_returns", p.min_valid_returns, { "returns", "a cloud with fewer valid returns is blind: counted, not fused; 0: off" });
+  get("input_period", p.input_period, { "s", "expected time between clouds, to count lost ones; 0: learnt from the stream" });
 }
 
 /// Why a cloud is blind.

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/cell_class.hpp"
 #include "map_aided_fusion/core/fusion.hpp"
 #include "map_aided_fusion/core/grid_ops.hpp"
@@ -120,40 +121,40 @@ struct MapGridParams
 template <class Get>
 void forEachParam(MapGridParams& p, Get&& get)
 {
-  get("size_x", p.size_x);
-  get("size_y", p.size_y);
-  get("resolution", p.resolution);
-  get("recentre_distance", p.recentre_distance);
-  get("alpha_static", p.fusion.discount.alpha_static);
-  get("alpha_dynamic", p.fusion.discount.alpha_dynamic);
-  get("alpha_free", p.fusion.discount.alpha_free);
-  get("alpha_per_second", p.rates_per_second);
-  get("delta_inc", p.fusion.counter.delta_inc);
-  get("delta_dec", p.fusion.counter.delta_dec);
-  get("gamma_occupied", p.fusion.counter.gamma_occupied);
-  get("gamma_conflict", p.fusion.counter.gamma_conflict);
+  get("size_x", p.size_x, { "m", "MapGrid window length along x (map frame, follows the vehicle)" });
+  get("size_y", p.size_y, { "m", "MapGrid window length along y" });
+  get("resolution", p.resolution, { "m", "cell side of the MapGrid (the paper: 0.5 m)" });
+  get("recentre_distance", p.recentre_distance, { "m", "the window is shifted by whole cells once the vehicle is farther than this from its centre" });
+  get("alpha_static", p.fusion.discount.alpha_static, { "", "discount rate α of θ_static = {C, N} per scan (per second with alpha_per_second)" });
+  get("alpha_dynamic", p.fusion.discount.alpha_dynamic, { "", "discount rate α of θ_dynamic = {S, V}" });
+  get("alpha_free", p.fusion.discount.alpha_free, { "", "discount rate α of θ_free = {F}" });
+  get("alpha_per_second", p.rates_per_second, { "", "rates α per second (1 − (1 − α)^Δt) rather than per scan as in the paper" });
+  get("delta_inc", p.fusion.counter.delta_inc, { "", "δ_inc: increment of the counter ζ per consistent occupied observation" });
+  get("delta_dec", p.fusion.counter.delta_dec, { "", "δ_dec: decrement of ζ per conflicting observation" });
+  get("gamma_occupied", p.fusion.counter.gamma_occupied, { "", "γ_O: occupied mass m_MG(O) a cell needs to count as occupied" });
+  get("gamma_conflict", p.fusion.counter.gamma_conflict, { "", "γ_∅: conflict ∅_FO + ∅_OF above this is a change" });
   bool literal = p.fusion.counter.mode == SpecialisationMode::kLiteral;
-  get("specialise_literal", literal);
+  get("specialise_literal", literal, { "", "specialisation as the paper's matrix reads (ζ·m({V}) to ∅, then normalised); false: to {S}" });
   p.fusion.counter.mode = literal ? SpecialisationMode::kLiteral : SpecialisationMode::kMovingToStopped;
   std::string rule = toString(p.fusion.rule);
-  get("combination_rule", rule);
+  get("combination_rule", rule, { "", "modified_yager (the paper), yager or dempster" });
   p.fusion.rule = parseCombinationRule(rule);
-  get("moving_expiry", p.fusion.moving_expiry);
-  get("decision_threshold", p.decision_threshold);
-  get("min_object_cells", p.min_object_cells);
-  get("max_object_length", p.max_object_length);
-  get("max_object_area", p.max_object_area);
-  get("thin_structure_width", p.thin_structure_width);
-  get("thin_structure_length", p.thin_structure_length);
-  get("memory_budget_mb", p.memory_budget_mb);
-  get("point_occupancy", p.point_occupancy);
-  get("motion_share", p.motion_share);
-  get("motion_max_cells", p.motion_max_cells);
-  get("motion_margin", p.motion_margin);
-  get("obstacle_clearance", p.obstacle_clearance);
-  get("map_conflict_gain", p.map_conflict_gain);
-  get("position_sigma", p.position_sigma);
-  get("threads", p.threads);
+  get("moving_expiry", p.fusion.moving_expiry, { "", "step: m({V}) goes to Ω where the scan holds no occupied mass" });
+  get("decision_threshold", p.decision_threshold, { "", "BetP a class needs to be a cell's decision" });
+  get("min_object_cells", p.min_object_cells, { "cells", "smaller connected S or V regions are noise, not objects" });
+  get("max_object_length", p.max_object_length, { "m", "longer S or V regions are structure, not an object" });
+  get("max_object_area", p.max_object_area, { "m²", "larger S or V regions are structure, not an object" });
+  get("thin_structure_width", p.thin_structure_width, { "m", "S regions at most this wide and longer than thin_structure_length are walls or fences" });
+  get("thin_structure_length", p.thin_structure_length, { "m", "see thin_structure_width" });
+  get("memory_budget_mb", p.memory_budget_mb, { "MiB", "memory the MapGrid window may take; a larger window is refused before allocation" });
+  get("point_occupancy", p.point_occupancy, { "", "step: occupied evidence in the window cell under each obstacle return" });
+  get("motion_share", p.motion_share, { "", "step motion spreading: share of V cells that makes a small occupied region one mover; 0: off" });
+  get("motion_max_cells", p.motion_max_cells, { "cells", "largest region motion spreading treats as one object" });
+  get("motion_margin", p.motion_margin, { "", "step: S or V within this BetP of each other is decided \"occupied, motion not yet known\"; 0: off" });
+  get("obstacle_clearance", p.obstacle_clearance, { "m", "step: no free evidence within this distance of an obstacle return; 0: off" });
+  get("map_conflict_gain", p.map_conflict_gain, { "", "step: growth of the per-cell map doubt η where the scan contradicts the map; 0: off" });
+  get("position_sigma", p.position_sigma, { "m", "σ of the vehicle position that softens the prior when no pose covariance is received" });
+  get("threads", p.threads, { "", "threads of the per-scan update; 0: every core (results identical for any value)" });
 }
 
 /// Wall time of each stage of MapGrid::update(), seconds.

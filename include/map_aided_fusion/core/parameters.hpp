@@ -12,6 +12,18 @@
 namespace map_aided_fusion {
 namespace core {
 
+/**
+ * @brief What the parameter reference (doc/parameters.md, tool `parameter_reference`) says of a parameter besides
+ *        its name, type, default and valid range, which it reads from the struct and its validate().
+ *
+ * Every forEachParam() list calls `get(name, field, ParamDoc{unit, meaning})`; a getter takes the three arguments.
+ */
+struct ParamDoc
+{
+  const char* unit;     ///< "m", "s", "m/s", …; "" for a ratio, a flag or a name
+  const char* meaning;  ///< one line
+};
+
 /// Thrown by the validate() of a parameter struct; the message starts with the parameter's name.
 class ParameterError : public std::invalid_argument
 {

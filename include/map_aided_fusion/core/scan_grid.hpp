@@ -37,6 +37,7 @@
 
 #include <Eigen/Geometry>
 
+#include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/core/ground_model.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
@@ -143,36 +144,36 @@ struct ScanGridParams
 template <class Get>
 void forEachParam(ScanGridParams& p, Get&& get)
 {
-  get("grid_resolution", p.grid_resolution);
-  get("grid_size_x", p.grid_size_x);
-  get("grid_size_y", p.grid_size_y);
-  get("grid_offset_x", p.grid_offset_x);
-  get("grid_offset_y", p.grid_offset_y);
-  get("azimuth_resolution_deg", p.azimuth_resolution_deg);
-  get("min_range", p.min_range);
-  get("max_range", p.max_range);
-  get("self_box_min_x", p.self_box_min_x);
-  get("self_box_max_x", p.self_box_max_x);
-  get("self_box_min_y", p.self_box_min_y);
-  get("self_box_max_y", p.self_box_max_y);
-  get("ground_height", p.ground_height);
-  get("ground_tolerance", p.ground_tolerance);
-  get("obstacle_min_height", p.obstacle_min_height);
-  get("obstacle_max_height", p.obstacle_max_height);
-  get("mu_free", p.mu_free);
-  get("mu_occupied", p.mu_occupied);
-  get("free_decay_length", p.free_decay_length);
-  get("free_margin", p.free_margin);
-  get("relative_height_limit", p.relative_height_limit);
-  get("deskew", p.deskew);
-  get("deskew_max_sweep_duration", p.deskew_max_sweep_duration);
-  get("ground_model", p.ground_model);
-  get("ground_sectors", p.ground_sectors);
-  get("ground_max_slope_deg", p.ground_max_slope_deg);
-  get("ground_min_points", p.ground_min_points);
-  get("ground_search_band", p.ground_search_band);
-  get("ground_fit_tolerance", p.ground_fit_tolerance);
-  get("threads", p.threads);
+  get("grid_resolution", p.grid_resolution, { "m", "ScanGrid cell side (the paper: 0.5 m)" });
+  get("grid_size_x", p.grid_size_x, { "m", "ScanGrid extent along x (vehicle frame)" });
+  get("grid_size_y", p.grid_size_y, { "m", "ScanGrid extent along y" });
+  get("grid_offset_x", p.grid_offset_x, { "m", "x of the ScanGrid centre in the vehicle frame" });
+  get("grid_offset_y", p.grid_offset_y, { "m", "y of the ScanGrid centre in the vehicle frame" });
+  get("azimuth_resolution_deg", p.azimuth_resolution_deg, { "deg", "width of an azimuth sector of the polar model" });
+  get("min_range", p.min_range, { "m", "returns nearer (horizontally) are rejected" });
+  get("max_range", p.max_range, { "m", "returns farther (horizontally) are rejected" });
+  get("self_box_min_x", p.self_box_min_x, { "m", "self filter: returns strictly inside this vehicle-frame box are the vehicle's own" });
+  get("self_box_max_x", p.self_box_max_x, { "m", "see self_box_min_x" });
+  get("self_box_min_y", p.self_box_min_y, { "m", "see self_box_min_x" });
+  get("self_box_max_y", p.self_box_max_y, { "m", "see self_box_min_x" });
+  get("ground_height", p.ground_height, { "m", "z of the ground in the vehicle frame (flat model; prediction of the planes model)" });
+  get("ground_tolerance", p.ground_tolerance, { "m", "a return within this of the ground is ground" });
+  get("obstacle_min_height", p.obstacle_min_height, { "m", "lowest obstacle return above the ground" });
+  get("obstacle_max_height", p.obstacle_max_height, { "m", "returns higher above the ground are ignored (overhangs)" });
+  get("mu_free", p.mu_free, { "", "μ_F: free mass between the sensor and a return" });
+  get("mu_occupied", p.mu_occupied, { "", "μ_O: occupied mass of a cell holding an obstacle return" });
+  get("free_decay_length", p.free_decay_length, { "m", "μ_F(r) = μ_F·exp(−r / L); 0: no decay" });
+  get("free_margin", p.free_margin, { "m", "cells nearer than this to a sector's first obstacle stay unknown rather than free" });
+  get("relative_height_limit", p.relative_height_limit, { "m", "step: a low obstacle return must stand obstacle_min_height above the lowest return around it; 0: off" });
+  get("deskew", p.deskew, { "", "step: clouds with a per-point time field are moved to the sensor pose at the stamp" });
+  get("deskew_max_sweep_duration", p.deskew_max_sweep_duration, { "s", "a point time beyond this after the stamp skips deskewing" });
+  get("ground_model", p.ground_model, { "", "flat (z = ground_height) or planes (RANSAC planes per zone and scan)" });
+  get("ground_sectors", p.ground_sectors, { "", "azimuth sectors per ring of the planes model" });
+  get("ground_max_slope_deg", p.ground_max_slope_deg, { "deg", "a fitted plane steeper than this against the body is refused" });
+  get("ground_min_points", p.ground_min_points, { "returns", "candidates and inliers a zone's fit needs" });
+  get("ground_search_band", p.ground_search_band, { "m", "a zone's candidates lie within this of the predicted ground" });
+  get("ground_fit_tolerance", p.ground_fit_tolerance, { "m", "RANSAC inlier distance" });
+  get("threads", p.threads, { "", "threads of the ScanGrid builder; 0: every core (results identical for any value)" });
 }
 
 /// Largest grid the builder accepts (cells), to refuse absurd sizes before allocating.

@@ -10,6 +10,8 @@
 #include <deque>
 #include <string>
 
+#include "map_aided_fusion/core/parameters.hpp"
+
 namespace map_aided_fusion {
 namespace core {
 
@@ -91,10 +93,10 @@ struct StreamHealthParams
 template <class Get>
 void forEachParam(StreamHealthParams& p, Get&& get)
 {
-  get("diagnostic_period", p.diagnostic_period);
-  get("diagnostic_window", p.diagnostic_window);
-  get("stale_warn", p.stale_warn);
-  get("stale_error", p.stale_error);
+  get("diagnostic_period", p.diagnostic_period, { "s", "time between diagnostic messages (wall time)" });
+  get("diagnostic_window", p.diagnostic_window, { "s", "history the diagnostics' rates and counts cover" });
+  get("stale_warn", p.stale_warn, { "s", "time without output before the status is WARN" });
+  get("stale_error", p.stale_error, { "s", "time without output before the status is ERROR" });
 }
 
 /// Severity of a diagnostic status, with diagnostic_msgs' numbering (OK 0, WARN 1, ERROR 2).

@@ -13,6 +13,8 @@
 #include <optional>
 #include <string>
 
+#include "map_aided_fusion/core/parameters.hpp"
+
 namespace map_aided_fusion {
 namespace core {
 
@@ -41,8 +43,8 @@ struct TimeGuardParams
 template <class Get>
 void forEachParam(TimeGuardParams& p, Get&& get)
 {
-  get("time_jump_threshold", p.time_jump_threshold);
-  get("max_plausible_speed", p.max_plausible_speed);
+  get("time_jump_threshold", p.time_jump_threshold, { "s", "a scan older than the last fused by more than this is a time jump (reset); less: dropped" });
+  get("max_plausible_speed", p.max_plausible_speed, { "m/s", "faster vehicle motion between two fused scans is reported as a pose jump" });
 }
 
 /// What to do with a scan.

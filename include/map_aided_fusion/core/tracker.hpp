@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
 
 namespace map_aided_fusion {
@@ -61,28 +62,28 @@ struct TrackerParams
 template <class Get>
 void forEachParam(TrackerParams& p, Get&& get)
 {
-  get("tracker", p.enabled);
-  get("tracker_cluster_distance", p.cluster_distance);
-  get("tracker_min_cluster_points", p.min_cluster_points);
-  get("tracker_background_zeta", p.background_zeta);
-  get("tracker_background_share", p.background_share);
-  get("tracker_max_object_length", p.max_object_length);
-  get("tracker_max_object_width", p.max_object_width);
-  get("tracker_measurement_sigma", p.measurement_sigma);
-  get("tracker_extent_sigma", p.extent_sigma);
-  get("tracker_acceleration_sigma", p.acceleration_sigma);
-  get("tracker_initial_speed_sigma", p.initial_speed_sigma);
-  get("tracker_gate", p.gate);
-  get("tracker_max_gate_distance", p.max_gate_distance);
-  get("tracker_confirm_hits", p.confirm_hits);
-  get("tracker_max_coast_time", p.max_coast_time);
-  get("tracker_moving_speed", p.moving_speed);
-  get("tracker_motion_sigmas", p.motion_sigmas);
-  get("tracker_stopped_speed", p.stopped_speed);
-  get("tracker_stopped_time", p.stopped_time);
-  get("tracker_max_speed", p.max_speed);
-  get("tracker_max_ego_speed", p.max_ego_speed);
-  get("tracker_evidence_weight", p.evidence_weight);
+  get("tracker", p.enabled, { "", "run the tracker (tracks topic, track evidence)" });
+  get("tracker_cluster_distance", p.cluster_distance, { "m", "returns in touching cells of half this size are one cluster" });
+  get("tracker_min_cluster_points", p.min_cluster_points, { "returns", "a cluster with fewer returns is no measurement" });
+  get("tracker_background_zeta", p.background_zeta, { "", "a return on a cell whose counter ζ is above this lies on static background" });
+  get("tracker_background_share", p.background_share, { "", "a cluster with more than this share of background returns is not tracked; 1: off" });
+  get("tracker_max_object_length", p.max_object_length, { "m", "a longer cluster (wall, fence, hedge) is no object" });
+  get("tracker_max_object_width", p.max_object_width, { "m", "a wider cluster is no object" });
+  get("tracker_measurement_sigma", p.measurement_sigma, { "m", "standard deviation of a compact cluster's centroid" });
+  get("tracker_extent_sigma", p.extent_sigma, { "m/m", "added standard deviation per metre of the cluster's extent on that axis" });
+  get("tracker_acceleration_sigma", p.acceleration_sigma, { "m/s²", "white-noise acceleration of the constant-velocity model" });
+  get("tracker_initial_speed_sigma", p.initial_speed_sigma, { "m/s", "velocity standard deviation of a new track" });
+  get("tracker_gate", p.gate, { "", "Mahalanobis² gate of an association (χ², 2 dof: 13.8 is 99.9 %)" });
+  get("tracker_max_gate_distance", p.max_gate_distance, { "m", "no association farther than this, whatever the covariance" });
+  get("tracker_confirm_hits", p.confirm_hits, { "scans", "consecutive associations that confirm a tentative track" });
+  get("tracker_max_coast_time", p.max_coast_time, { "s", "time without an association before a confirmed track is deleted" });
+  get("tracker_moving_speed", p.moving_speed, { "m/s", "moving when speed − motion_sigmas·σ(speed) is above this" });
+  get("tracker_motion_sigmas", p.motion_sigmas, { "", "standard deviations the speed must clear to call a motion state" });
+  get("tracker_stopped_speed", p.stopped_speed, { "m/s", "stopped when speed + motion_sigmas·σ(speed) stays below this for stopped_time" });
+  get("tracker_stopped_time", p.stopped_time, { "s", "see tracker_stopped_speed" });
+  get("tracker_max_speed", p.max_speed, { "m/s", "a track estimated faster is deleted (a wrong association)" });
+  get("tracker_max_ego_speed", p.max_ego_speed, { "m/s", "a vehicle pose moving faster between two scans resets every track" });
+  get("tracker_evidence_weight", p.evidence_weight, { "", "step track evidence: weight w of a track's motion in its cells (β = w·P(motion)); 0: off" });
 }
 
 /**

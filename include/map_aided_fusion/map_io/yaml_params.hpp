@@ -32,7 +32,7 @@ inline YAML::Node loadYamlFile(const std::string& path)
 /// A getter for forEachParam(): absent keys keep their defaults; a value of the wrong type is a ParameterError.
 inline auto yamlReader(const YAML::Node& root)
 {
-  return [root](const std::string& name, auto& value) {
+  return [root](const std::string& name, auto& value, const core::ParamDoc&) {
     if (!root || !root.IsMap()) return;
     const YAML::Node n = root[name];
     if (!n) return;

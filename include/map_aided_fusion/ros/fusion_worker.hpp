@@ -70,6 +70,22 @@ struct FusionNodeParams
   static FusionNodeParams load(const ros::NodeHandle& pnh);
 };
 
+/// Calls get(name, field, doc) for every parameter of @p p, with the names of config/fusion.yaml.
+template <class Get>
+void forEachParam(FusionNodeParams& p, Get&& get)
+{
+  get("map_frame", p.map_frame, { "", "fixed frame of the MapGrid and of the PriorGrid" });
+  get("base_frame", p.base_frame, { "", "vehicle frame" });
+  get("tf_queue_size", p.tf_queue_size, { "scans", "scans waiting for their transform" });
+  get("future_tolerance", p.future_tolerance, { "s", "a scan may be stamped this far ahead of a lagging clock" });
+  get("publish_free_cells", p.publish_free_cells, { "", "also draw free cells in the cells markers" });
+  get("object_box_height", p.object_box_height, { "m", "height of the object boxes" });
+  get("pose_covariance_topic", p.pose_covariance_topic, { "", "topic of the vehicle pose covariance (\"\": position_sigma is used)" });
+  get("pose_covariance_type", p.pose_covariance_type, { "", "pose (PoseWithCovarianceStamped) or odometry (nav_msgs/Odometry)" });
+  core::forEachParam(p.time, get);
+  core::forEachParam(p.health, get);
+}
+
 /**
  * Topics: in `scan_grid`, `prior_grid`, and the pose covariance when configured; out `map_grid`, `betp/<class>`,
  * `decision`, `navigable`, `cells`, `objects`.

@@ -34,7 +34,7 @@ void readParam(const ros::NodeHandle& nh, const std::string& name, double& value
 /// A getter for core::forEachParam() that reads from @p nh (absent parameters keep their defaults).
 inline auto parameterServerReader(const ros::NodeHandle& nh)
 {
-  return [&nh](const std::string& name, auto& value) { readParam(nh, name, value); };
+  return [&nh](const std::string& name, auto& value, const core::ParamDoc&) { readParam(nh, name, value); };
 }
 
 /**

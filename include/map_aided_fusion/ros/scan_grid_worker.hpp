@@ -62,6 +62,22 @@ struct ScanGridNodeParams
   static ScanGridNodeParams load(const ros::NodeHandle& pnh);
 };
 
+/// Calls get(name, field, doc) for every parameter of @p p, with the names of config/scan_grid.yaml.
+template <class Get>
+void forEachParam(ScanGridNodeParams& p, Get&& get)
+{
+  get("base_frame", p.base_frame, { "", "vehicle frame of the published grids" });
+  get("input_queue_size", p.input_queue_size, { "clouds", "clouds buffered by the subscriber" });
+  get("tf_queue_size", p.tf_queue_size, { "clouds", "clouds waiting for their transform" });
+  get("future_tolerance", p.future_tolerance, { "s", "a cloud may be stamped this far ahead of a lagging clock" });
+  get("time_jump_threshold", p.time_jump_threshold, { "s", "ROS time going back by more than this is a jump (tf buffer cleared)" });
+  get("deskew_fixed_frame", p.deskew_fixed_frame, { "", "frame the vehicle moves in, for a sweep's motion (odom on a vehicle)" });
+  get("deskew_time_field", p.deskew_time_field, { "", "per-point time field, or auto" });
+  core::forEachParam(p.health, get);
+  core::forEachParam(p.input, get);
+  core::forEachParam(p.model, get);
+}
+
 /// Counters since start, reported by the diagnostics.
 struct ScanGridNodeCounters
 {
