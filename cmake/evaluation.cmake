@@ -14,14 +14,24 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_metrics map_aided_fusion_eval)
 endif()
 
+# The offline replay (bags through the core, scored, reported): a library, so that tests reach it piece by piece;
+# `evaluate` parses its options and calls it.
+add_library(map_aided_fusion_replay src/replay/offline_replay.cpp src/replay/options.cpp src/replay/report.cpp
+  src/replay/variants.cpp src/replay/npy.cpp)
+target_link_libraries(map_aided_fusion_replay map_aided_fusion_eval map_aided_fusion_map_io
+  map_aided_fusion_scan_grid_nodelet map_aided_fusion_dataset_ros yaml-cpp ${catkin_LIBRARIES})
+add_dependencies(map_aided_fusion_replay ${PROJECT_NAME}_generate_messages_cpp)
 add_executable(evaluate src/tools/evaluate.cpp)
-target_link_libraries(evaluate map_aided_fusion_eval map_aided_fusion_map_io map_aided_fusion_scan_grid_nodelet
-  map_aided_fusion_dataset_ros
-  yaml-cpp ${catkin_LIBRARIES})
-add_dependencies(evaluate ${PROJECT_NAME}_generate_messages_cpp)
-install(TARGETS evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+target_link_libraries(evaluate map_aided_fusion_replay)
+install(TARGETS map_aided_fusion_replay evaluate
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(test_replay test/replay/test_replay.cpp test/test_main.cpp)
+  target_link_libraries(test_replay map_aided_fusion_replay map_aided_fusion_sim_bag)
+  target_compile_definitions(test_replay PRIVATE MAF_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
   add_rostest_gtest(test_demo_scores test/demo.test test/ros/test_demo_scores.cpp)
   target_link_libraries(test_demo_scores map_aided_fusion_eval ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
   add_rostest_gtest(test_kitti_replay test/kitti_replay.test test/ros/test_kitti_replay.cpp)

@@ -59,7 +59,7 @@ ONE_SECOND = 1.0 + 1e-6
 
 
 def pool_movers(metrics_list):
-    """Moving objects pooled over several drives' `evaluate` variants (their `movers_objects`, README "Scoring
+    """Moving objects pooled over several drives' `evaluate` variants (their `movers_objects`, doc/evaluation.md "Scoring
     moving objects"): movers seen, detected within 0.5 s and 1 s, never V, the median delay (never V counts as
     infinite: None when more than half never are), the mean V share over movers, the S share of their cells."""
     movers = [o for m in metrics_list for o in m.get("movers_objects", {}).get("objects", [])

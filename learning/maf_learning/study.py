@@ -328,7 +328,7 @@ def report(setup, log=print):
     learned_dir = os.path.abspath(a.profile_out)
     header = (f"# Learned by learning/tune (study '{a.study}', trial #{best.number}, score {best.value:.4f} on the "
               f"training drives\n# {', '.join(study.user_attrs.get('training_drives', []))}); "
-              "every other key as in config/. README: \"Learned parameters\".\n")
+              "every other key as in config/. doc/learning.md.\n")
     sp.write_config_dir(learned_dir, values, setup.config, header)
     log(f"wrote {learned_dir}/ (fusion, scan_grid, prior_grid, ibeo/scan_grid) from trial #{best.number}")
     dirs = {"paper": (os.path.join(setup.config, "paper"), "paper"), "default": (setup.config, "default"),

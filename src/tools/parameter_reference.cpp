@@ -13,16 +13,19 @@ namespace maf = map_aided_fusion;
 
 namespace {
 
+/// The reference rows of a struct whose defaults validate, as a table.
 template <class Params>
-std::string table(const Params& defaults, const Params& base)
+std::string table()
 {
+  const Params defaults;
+  const Params& base = defaults;
   return maf::core::markdownTable(maf::core::describeParams(
       defaults, base, [](Params& p, auto&& get) { forEachParam(p, get); }, [](const Params& p) { p.validate(); }));
 }
 
 }  // namespace
 
-int main(int argc, char** argv)
+int main(int argc, char**)
 {
   if (argc > 1)
   {
@@ -47,10 +50,10 @@ int main(int argc, char** argv)
                "`map_file` has no default; the range of `origin_latitude` and `origin_longitude` is probed with both set.\n\n"
             << prior_table
             << "\n## ScanGrid (`ScanGridNodelet`, `config/scan_grid.yaml`)\n\n"
-            << table(maf::ScanGridNodeParams{}, maf::ScanGridNodeParams{})
+            << table<maf::ScanGridNodeParams>()
             << "\n## Fusion (`FusionNodelet`, `config/fusion.yaml`)\n\n### Node\n\n"
-            << table(maf::FusionNodeParams{}, maf::FusionNodeParams{}) << "\n### MapGrid\n\n"
-            << table(maf::core::MapGridParams{}, maf::core::MapGridParams{}) << "\n### Tracker\n\n"
-            << table(maf::core::TrackerParams{}, maf::core::TrackerParams{});
+            << table<maf::FusionNodeParams>() << "\n### MapGrid\n\n"
+            << table<maf::core::MapGridParams>() << "\n### Tracker\n\n"
+            << table<maf::core::TrackerParams>();
   return 0;
 }

@@ -1,4 +1,4 @@
-// The steps this package adds so that V means moving (README, "V must mean moving"): scripted scenes with a known
+// The steps this package adds so that V means moving (doc/steps.md, "V must mean moving"): scripted scenes with a known
 // answer, each run with the default profile and with the paper's profile.
 #include <gtest/gtest.h>
 

@@ -9,7 +9,7 @@
  * cell's centre. Where buildings and roads overlap in real data (the paper assumes they never do), the
  * building wins. Holes of polygons (courtyards) keep the class underneath (kOther unless a road is there).
  *
- * PriorCellTest::kCoverage (not in the paper; README, "Cell coverage") also keeps, per cell, which of
+ * PriorCellTest::kCoverage (not in the paper; doc/steps.md, "Cell coverage") also keeps, per cell, which of
  * kCoverageSamples sample points lie in a building and on a road, and whether a building outline crosses the
  * cell. Its masses: a cell an outline crosses → m(W = {F,C}) = β_B (what a lidar sees of a building is its
  * wall: occupied there is the building, the rest of the cell can be free); a cell inside buildings → m(B) = β_B;

@@ -1,7 +1,7 @@
 /**
  * @file prior_uncertainty.hpp
- * @brief The PriorGrid softened by position uncertainty (not in the paper; README, "Map and pose
- *        uncertainty"): of the map (its positional accuracy per layer) and of the vehicle (σ of its pose).
+ * @brief The PriorGrid softened by position uncertainty (not in the paper; doc/steps.md, "The map is not exact,
+ *        nor is the pose"): of the map (its positional accuracy per layer) and of the vehicle (σ of its pose).
  *
  * With a Gaussian position error of standard deviation σ (metres, isotropic), a cell's prior is the linear pool
  * of the cells around it: m(B), m(R), m(T) are blurred by the normalised Gaussian kernel. The outline mass

@@ -28,7 +28,7 @@ struct Profile
 };
 
 /**
- * @brief A step this package adds to the paper's pipeline: a name (its section in the README), what it does,
+ * @brief A step this package adds to the paper's pipeline: a name (its entry in doc/steps.md), what it does,
  *        and how to tell and switch it in a profile. Each is off in the paper profile.
  */
 struct AddedStep

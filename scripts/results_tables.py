@@ -1,0 +1,180 @@
+#!/usr/bin/env python3
+"""Results tables from the metrics.json files `evaluate` writes (scripts/demo calls it).
+
+    results_tables.py OUT [--doc DOC_DIR --readme README.md]
+
+Writes OUT/results.md (every table) and OUT/results_summary.md (the README's table: default against paper on the
+simulator, KITTI 00 and KITTI tracking). With --doc and --readme, and only when every dataset was evaluated, also
+DOC_DIR/results.md, the README's block between the `results:begin` and `results:end` markers and (--figure) the
+picture under DOC_DIR/images/: the documentation then shows what this run measured, never a typed figure.
+"""
+import argparse
+import json
+import os
+import shutil
+import sys
+
+BEGIN = "<!-- results:begin (scripts/demo writes this table; do not edit) -->"
+END = "<!-- results:end -->"
+
+SIMULATOR = "default scenario (simulator, 600 scans, town map)"
+KITTI00 = "KITTI 00 (real, 10 sweeps, 3 labelled, no map)"
+TRACKING = "KITTI tracking 0000 (real, 154 sweeps, 5 movers, no map)"
+
+
+def load(path):
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)["variants"]
+
+
+def num(v, digits=3):
+    if v is None:
+        return "–"
+    if isinstance(v, str):
+        return v
+    return f"{v:.{digits}f}"
+
+
+def frac(v, key_num, key_den):
+    a, b = v.get(key_num), v.get(key_den)
+    if a is None or b is None:
+        return "–"
+    return f"{int(a)}/{int(b)}"
+
+
+# (column title, function of one variant's metrics)
+SIM_COLUMNS = [
+    ("IoU F", lambda v: num(v.get("free.iou"))),
+    ("IoU C", lambda v: num(v.get("building.iou"))),
+    ("IoU N", lambda v: num(v.get("infrastructure.iou"))),
+    ("IoU S", lambda v: num(v.get("stopped.iou"))),
+    ("IoU V", lambda v: num(v.get("moving.iou"))),
+    ("V precision", lambda v: num(v.get("moving.precision"))),
+    ("V recall", lambda v: num(v.get("moving.recall"))),
+    ("movers V ≤ 0.5 s", lambda v: frac(v, "movers.all.detected_within_0_5s", "movers.all.seen")),
+    ("movers V ≤ 1 s", lambda v: frac(v, "movers.all.detected_within_1s", "movers.all.seen")),
+    ("stopped called moving", lambda v: num(v.get("objects.stopped.called_moving_rate"))),
+    ("V trail (cells/scan)", lambda v: num(v.get("moving.trail_cells_per_scan"), 1)),
+    ("MOTA", lambda v: num(v.get("tracks.mota"), 2)),
+    ("velocity RMSE (m/s)", lambda v: num(v.get("tracks.velocity_rmse_mps"), 2)),
+]
+KITTI_COLUMNS = [
+    ("V cells / sweep", lambda v: num(v.get("v_cells_per_sweep"), 1)),
+    ("false V / labelled sweep", lambda v: num(v.get("false_v_per_labelled_sweep"), 1)),
+    ("V on static points / labelled sweep", lambda v: num(v.get("v_on_static_per_labelled_sweep"), 1)),
+    ("motorcyclist cells V", lambda v: num(v.get("mover_cells_v_share"), 2)),
+    ("motorcyclist V share from its 3rd sweep", lambda v: num(v.get("mover_min_v_share_from_third_sweep"), 2)),
+    ("first V (s)", lambda v: "never" if (v.get("mover_first_v_delay_s") or -1) < 0
+     else num(v.get("mover_first_v_delay_s"), 2)),
+]
+TRACKING_COLUMNS = [
+    ("movers V ≤ 0.5 s", lambda v: frac(v, "movers.all.detected_within_0_5s", "movers.all.seen")),
+    ("movers V ≤ 1 s", lambda v: frac(v, "movers.all.detected_within_1s", "movers.all.seen")),
+    ("movers' mean V share", lambda v: num(v.get("movers.all.mean_v_share"), 2)),
+    ("movers' cells S", lambda v: num(v.get("movers.all.s_share"), 3)),
+    ("parked V share", lambda v: num(v.get("parked.all.v_share"), 3)),
+    ("false V / scan", lambda v: num(v.get("movers.false_v_per_scan"), 2)),
+    ("MOTA", lambda v: num(v.get("tracks.mota"), 2)),
+    ("velocity median error (m/s)", lambda v: num(v.get("tracks.velocity_median_mps"), 2)),
+]
+
+
+def table(variants, columns, names=None):
+    names = [n for n in (names or variants.keys()) if n in variants]
+    head = "| variant | " + " | ".join(c for c, _ in columns) + " |\n"
+    rule = "| --- | " + " | ".join("---:" for _ in columns) + " |\n"
+    rows = "".join("| " + n + " | " + " | ".join(f(variants[n]) for _, f in columns) + " |\n" for n in names)
+    return head + rule + rows
+
+
+def summary(sim, kitti, tracking):
+    """One table: each dataset's key figures for the default and the paper profiles."""
+    lines = ["| data | figure | default | paper |", "| --- | --- | ---: | ---: |"]
+
+    def add(data, variants, title, f):
+        if variants and "default" in variants and "paper" in variants:
+            lines.append(f"| {data} | {title} | {f(variants['default'])} | {f(variants['paper'])} |")
+
+    cols = dict(SIM_COLUMNS)
+    for title in ("IoU F", "IoU C", "V precision", "V recall", "movers V ≤ 1 s", "V trail (cells/scan)"):
+        add("simulator", sim, title, cols[title])
+    cols = dict(KITTI_COLUMNS)
+    for title in ("false V / labelled sweep", "motorcyclist V share from its 3rd sweep"):
+        add("KITTI 00", kitti, title, cols[title])
+    cols = dict(TRACKING_COLUMNS)
+    for title in ("movers V ≤ 1 s", "movers' mean V share", "movers' cells S", "false V / scan"):
+        add("KITTI tracking", tracking, title, cols[title])
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out")
+    ap.add_argument("--doc")
+    ap.add_argument("--readme")
+    ap.add_argument("--figure", help="a picture to copy to DOC_DIR/images/ with the tables (figure2.png)")
+    a = ap.parse_args()
+    sim = load(os.path.join(a.out, "metrics.json"))
+    kitti = load(os.path.join(a.out, "kitti", "metrics.json"))
+    tracking = load(os.path.join(a.out, "kitti_tracking", "metrics.json"))
+    if sim is None:
+        sys.exit(f"results_tables.py: {a.out}/metrics.json is missing (run scripts/demo)")
+
+    parts = ["# Results\n\n",
+             "Written by `scripts/demo` from the `metrics.json` files of `evaluate` (do not edit). "
+             "`default` is `config/`, `paper` is `config/paper/` (the paper's exact method), `live` the nodelets "
+             "replaying the bag; `default_without_<step>` is the default with one added step off (doc/steps.md), "
+             "`dempster`, `yager`, `single_rate`, `no_counter` are ablations of the paper. "
+             "doc/evaluation.md defines every figure.\n\n",
+             "## Summary\n\n", summary(sim, kitti, tracking),
+             f"\n## {SIMULATOR}\n\n", table(sim, SIM_COLUMNS)]
+    if kitti:
+        parts += [f"\n## {KITTI00}\n\n", table(kitti, KITTI_COLUMNS)]
+    if tracking:
+        parts += [f"\n## {TRACKING}\n\n", table(tracking, TRACKING_COLUMNS)]
+    lies = [(n, load(os.path.join(a.out, n, "metrics.json")))
+            for n in ("pose_bias", "pose_random_walk", "map_shift", "fast_ego_10", "fast_ego_15", "sloped_road", "ibeo")]
+    lies = [(n, v) for n, v in lies if v]
+    if lies:
+        parts.append("\n## Scenarios of a simulator that lies and of real-sensor effects\n\n")
+        parts.append("`scenarios/<name>.yaml`; doc/steps.md says what each one tests.\n\n")
+        head = "| scenario | " + table({}, SIM_COLUMNS).splitlines()[0][len("| variant | "):] + "\n"
+        rule = "| --- | --- | " + " | ".join("---:" for _ in SIM_COLUMNS) + " |\n"
+        parts.append(head.replace("| scenario | ", "| scenario | profile | ", 1) + rule)
+        for n, v in lies:
+            for profile in ("default", "paper"):
+                if profile in v:
+                    parts.append(f"| `{n}` | {profile} | " + " | ".join(f(v[profile]) for _, f in SIM_COLUMNS) + " |\n")
+    text = "".join(p if p.endswith("\n") else p + "\n" for p in parts)
+    with open(os.path.join(a.out, "results.md"), "w") as f:
+        f.write(text)
+    with open(os.path.join(a.out, "results_summary.md"), "w") as f:
+        f.write(summary(sim, kitti, tracking))
+    print(f"wrote {a.out}/results.md")
+
+    if a.doc and a.readme:
+        missing = [name for name, v in (("KITTI 00", kitti), ("KITTI tracking", tracking)) if v is None]
+        if missing:
+            print(f"results_tables.py: {', '.join(missing)} not evaluated (../shared/data absent): "
+                  "doc/results.md and the README are left as they are")
+            return
+        with open(os.path.join(a.doc, "results.md"), "w") as f:
+            f.write(text)
+        with open(a.readme) as f:
+            readme = f.read()
+        i, j = readme.find(BEGIN), readme.find(END)
+        if i < 0 or j < i:
+            sys.exit(f"results_tables.py: {a.readme} has no results markers")
+        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, kitti, tracking) + readme[j:]
+        with open(a.readme, "w") as f:
+            f.write(readme)
+        print(f"wrote {a.doc}/results.md and the README's results table")
+        if a.figure:
+            os.makedirs(os.path.join(a.doc, "images"), exist_ok=True)
+            shutil.copyfile(a.figure, os.path.join(a.doc, "images", os.path.basename(a.figure)))
+
+
+if __name__ == "__main__":
+    main()

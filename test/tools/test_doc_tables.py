@@ -1,0 +1,97 @@
+"""The generated tables of the documentation: scripts/results_tables.py (scripts/demo) and scripts/bench_table.py
+(scripts/bench) on inputs with known answers, and the checked-in README and doc/results.md agreeing."""
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+RESULTS = os.path.join(ROOT, "scripts", "results_tables.py")
+BENCH = os.path.join(ROOT, "scripts", "bench_table.py")
+BEGIN = "<!-- results:begin (scripts/demo writes this table; do not edit) -->"
+END = "<!-- results:end -->"
+
+
+def write_metrics(path, variants):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        json.dump({"meta": {}, "variants": variants}, f)
+
+
+def sim(iou_f, movers):
+    return {"free.iou": iou_f, "building.iou": 0.5, "moving.precision": 0.25, "moving.recall": 0.125,
+            "movers.all.detected_within_1s": movers, "movers.all.seen": 11, "moving.trail_cells_per_scan": 0.5}
+
+
+def fake_readme(tmp):
+    path = os.path.join(tmp, "README.md")
+    with open(path, "w") as f:
+        f.write(f"# x\n\n{BEGIN}\nold table\n{END}\n\nafter\n")
+    return path
+
+
+def run(*args):
+    return subprocess.run([sys.executable, RESULTS, *args], capture_output=True, text=True, check=True)
+
+
+def test_summary_reads_each_profile_from_its_variant(tmp_path):
+    out = tmp_path / "out"
+    write_metrics(str(out / "metrics.json"), {"default": sim(0.875, 4), "paper": sim(0.5, 7)})
+    write_metrics(str(out / "kitti" / "metrics.json"),
+                  {"default": {"false_v_per_labelled_sweep": 2.5}, "paper": {"false_v_per_labelled_sweep": 140}})
+    write_metrics(str(out / "kitti_tracking" / "metrics.json"),
+                  {"default": {"movers.all.detected_within_1s": 3, "movers.all.seen": 5},
+                   "paper": {"movers.all.detected_within_1s": 1, "movers.all.seen": 5}})
+    (tmp_path / "doc").mkdir()
+    readme = fake_readme(str(tmp_path))
+    figure = tmp_path / "figure2.png"
+    figure.write_bytes(b"png")
+    run(str(out), "--doc", str(tmp_path / "doc"), "--readme", readme, "--figure", str(figure))
+    text = open(readme).read()
+    assert "| simulator | IoU F | 0.875 | 0.500 |" in text
+    assert "| simulator | movers V ≤ 1 s | 4/11 | 7/11 |" in text
+    assert "| KITTI 00 | false V / labelled sweep | 2.5 | 140.0 |" in text
+    assert "| KITTI tracking | movers V ≤ 1 s | 3/5 | 1/5 |" in text
+    assert "old table" not in text and text.endswith("after\n")
+    doc = open(tmp_path / "doc" / "results.md").read()
+    assert "## KITTI 00" in doc and "| default | 0.875 |" in doc
+    assert (tmp_path / "doc" / "images" / "figure2.png").read_bytes() == b"png"
+
+
+def test_docs_are_left_alone_without_the_real_datasets(tmp_path):
+    out = tmp_path / "out"
+    write_metrics(str(out / "metrics.json"), {"default": sim(0.875, 4), "paper": sim(0.5, 7)})
+    (tmp_path / "doc").mkdir()
+    readme = fake_readme(str(tmp_path))
+    r = run(str(out), "--doc", str(tmp_path / "doc"), "--readme", readme)
+    assert "left as they are" in r.stdout
+    assert "old table" in open(readme).read()
+    assert not (tmp_path / "doc" / "results.md").exists()
+    assert "| default | 0.875 |" in open(out / "results.md").read()
+
+
+def test_checked_in_readme_shows_the_summary_of_doc_results():
+    readme = open(os.path.join(ROOT, "README.md")).read()
+    block = readme[readme.index(BEGIN) + len(BEGIN):readme.index(END)].strip()
+    results = open(os.path.join(ROOT, "doc", "results.md")).read()
+    assert block and block in results, "README and doc/results.md come from different runs: run scripts/demo"
+
+
+def test_bench_table_gives_ratios_within_one_run(tmp_path):
+    data = {"context": {"host_name": "h", "num_cpus": 2, "mhz_per_cpu": 2000, "date": "2026-12-03T10:00:00"},
+            "benchmarks": [
+                {"name": "BM_MapGridUpdate/n:800/threads:1/real_time_median", "run_name": "BM_MapGridUpdate/n:800/threads:1/real_time",
+                 "run_type": "aggregate", "aggregate_name": "median", "real_time": 20.0, "time_unit": "ms", "repetitions": 5},
+                {"name": "BM_MapGridUpdate/n:800/threads:2/real_time_median", "run_name": "BM_MapGridUpdate/n:800/threads:2/real_time",
+                 "run_type": "aggregate", "aggregate_name": "median", "real_time": 12500.0, "time_unit": "us", "repetitions": 5},
+                {"name": "BM_MapGridUpdate/n:800/threads:2/real_time_mean", "run_name": "BM_MapGridUpdate/n:800/threads:2/real_time",
+                 "run_type": "aggregate", "aggregate_name": "mean", "real_time": 99.0, "time_unit": "ms", "repetitions": 5},
+            ]}
+    path = tmp_path / "bench.json"
+    path.write_text(json.dumps(data))
+    doc = tmp_path / "performance.md"
+    doc.write_text("x\n<!-- bench:begin (scripts/bench writes this table; do not edit) -->\nold\n<!-- bench:end -->\n")
+    subprocess.run([sys.executable, BENCH, str(path), "--doc", str(doc)], check=True, capture_output=True)
+    text = doc.read_text()
+    assert "| `BM_MapGridUpdate/n:800/threads:2` | the same, 2 threads | 12.500 | 0.62 | `BM_MapGridUpdate/n:800/threads:1` |" in text
+    assert "medians of 5 repetitions" in text and "2 CPUs" in text and "old" not in text
