@@ -1,6 +1,10 @@
 #include "map_aided_fusion/core/sliding_window.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
+#include <vector>
 
 #include "map_aided_fusion/core/parameters.hpp"
 
@@ -23,6 +27,20 @@ std::string format(const char* fmt, double a, double b = 0.0)
 }
 
 }  // namespace
+
+double SlidingSamples::quantile(double now, double q)
+{
+  prune(now);
+  if (samples_.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> v;
+  v.reserve(samples_.size());
+  for (const Sample& s : samples_) v.push_back(s.value);
+  const double clamped = std::min(1.0, std::max(0.0, q));
+  const auto rank = static_cast<std::size_t>(std::ceil(clamped * static_cast<double>(v.size())));
+  const std::size_t k = rank == 0 ? 0 : rank - 1;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
 
 void StreamHealthParams::validate() const
 {

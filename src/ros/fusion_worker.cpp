@@ -30,6 +30,7 @@ constexpr double kMaxObjectBoxHeight = 100.0;
 /// Wall period of the clock watch (backward /clock jumps, transforms ahead of the clock), s.
 constexpr double kClockCheckPeriod = 0.1;
 constexpr double kWarnThrottle = 1.0;
+constexpr double kMillisecondsPerSecond = 1000.0;
 /// |Σm − 1| a scan cell may have (float rounding of the ScanGrid and its message).
 constexpr float kMassSumTolerance = 1e-3f;
 constexpr const char* kBetpTopics[core::FrameMG::kSize] = { "betp/free", "betp/building", "betp/infrastructure",
@@ -86,6 +87,7 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   , reconfigure_(pnh)
 {
   start_wall_ = core::steadySeconds();
+  latency_.setSpan(node_params_.health.diagnostic_window);
   map_grid_pub_ = nh_.advertise<EvidentialGrid>("map_grid", 1);
   for (int e = 0; e < core::FrameMG::kSize; ++e) betp_pub_[e] = nh_.advertise<nav_msgs::OccupancyGrid>(kBetpTopics[e], 1);
   decision_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("decision", 1);
@@ -363,9 +365,17 @@ void FusionWorker::checkClock()
   }
 }
 
+void FusionWorker::LatencyWindows::setSpan(double span)
+{
+  for (core::SlidingSamples* w : { &cloud_to_callback, &cloud_to_decision, &conversion, &shift, &project_scan,
+                                   &prior_window, &fusion, &tracking, &outputs })
+    w->setSpan(span);
+}
+
 void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
 {
   const auto wall0 = std::chrono::steady_clock::now();
+  const double cloud_age_ms = kMillisecondsPerSecond * (ros::Time::now() - msg->header.stamp).toSec();
   // Reused from scan to scan (one per callback thread): no 10 MB allocation, page faults and zeroing per scan.
   thread_local core::ScanMassGrid scan;
   try
@@ -507,6 +517,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   }
   core::StageTimes times;
   const core::ObstaclePoints obstacles{ msg->obstacle_points.data(), msg->obstacle_points.size() / 2 };
+  const auto update_start = std::chrono::steady_clock::now();
   const auto stats =
       grid_.update(scan, pose, stamp, prior, &times, msg->obstacle_points.empty() ? nullptr : &obstacles);
   stamp_guard_.accept(stamp);
@@ -520,9 +531,23 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   std_msgs::Header header;
   header.stamp = msg->header.stamp;
   header.frame_id = node_params_.map_frame;
+  const auto tracking_start = std::chrono::steady_clock::now();
   if (tracker_) track(header, stamp, pose, obstacles);
+  const auto outputs_start = std::chrono::steady_clock::now();
   publish(header, prior);
-  last_total_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const auto end = std::chrono::steady_clock::now();
+  last_total_seconds_ = std::chrono::duration<double>(end - wall0).count();
+  const auto ms = [](auto a, auto b) { return kMillisecondsPerSecond * std::chrono::duration<double>(b - a).count(); };
+  const double now = last_fused_wall_;
+  latency_.cloud_to_callback.add(now, cloud_age_ms);
+  latency_.cloud_to_decision.add(now, kMillisecondsPerSecond * (ros::Time::now() - msg->header.stamp).toSec());
+  latency_.conversion.add(now, ms(wall0, update_start));
+  latency_.shift.add(now, kMillisecondsPerSecond * times.shift);
+  latency_.project_scan.add(now, kMillisecondsPerSecond * times.project_scan);
+  latency_.prior_window.add(now, kMillisecondsPerSecond * times.prior_window);
+  latency_.fusion.add(now, kMillisecondsPerSecond * times.fusion);
+  latency_.tracking.add(now, ms(tracking_start, outputs_start));
+  latency_.outputs.add(now, ms(outputs_start, end));
 }
 
 void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWindow* prior)
@@ -653,6 +678,26 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("time prior window [ms]", 1e3 * last_times_.prior_window);
   status.add("time fusion [ms]", 1e3 * last_times_.fusion);
   status.add("time total with outputs [ms]", 1e3 * last_total_seconds_);
+  // Over the window: where a scan's time goes, from the cloud's stamp to its decision.
+  const auto quantiles = [&](const std::string& name, core::SlidingSamples& w) {
+    for (const auto& [q, label] : { std::pair<double, const char*>{ 0.5, " median [ms]" }, { 0.9, " p90 [ms]" } })
+    {
+      const double v = w.quantile(now, q);
+      if (std::isnan(v))
+        status.add(name + label, "none");
+      else
+        status.add(name + label, v);
+    }
+  };
+  quantiles("latency cloud to fusion callback", latency_.cloud_to_callback);
+  quantiles("latency cloud to decision", latency_.cloud_to_decision);
+  quantiles("stage conversion", latency_.conversion);
+  quantiles("stage shift", latency_.shift);
+  quantiles("stage project scan", latency_.project_scan);
+  quantiles("stage prior window", latency_.prior_window);
+  quantiles("stage fusion step", latency_.fusion);
+  quantiles("stage tracking", latency_.tracking);
+  quantiles("stage outputs", latency_.outputs);
   status.add("mean conflict", last_mean_conflict_);
   status.add("memory [MiB]", grid_.params().bytesNeeded() / (1024.0 * 1024.0));
   status.add("prior", softener_.raw() ? "received" : "none (vacuous)");

@@ -1,6 +1,7 @@
 #include "map_aided_fusion/ros/scan_grid_worker.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <boost/make_shared.hpp>
@@ -104,6 +105,8 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   for (auto* w : { &received_window_, &published_window_, &rejected_window_, &deskew_skipped_window_,
                    &ground_fallback_window_, &lost_window_, &overrun_window_, &stream_gap_window_ })
     w->setSpan(params_.health.diagnostic_window);
+  processing_samples_.setSpan(params_.health.diagnostic_window);
+  cloud_to_published_.setSpan(params_.health.diagnostic_window);
   start_wall_ = core::steadySeconds();
   clock_jump_.setThreshold(params_.time_jump_threshold);
   diagnostic_timer_ = nh_.createWallTimer(ros::WallDuration(params_.health.diagnostic_period),
@@ -336,6 +339,9 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   window_processing_sum_ += elapsed;
   window_processing_max_ = std::max(window_processing_max_, elapsed);
   ++window_processed_;
+  processing_samples_.add(last_published_wall_, kMillisecondsPerSecond * elapsed);
+  cloud_to_published_.add(last_published_wall_,
+                          kMillisecondsPerSecond * (ros::Time::now() - cloud->header.stamp).toSec());
   if (gaps_.period() > 0.0 && elapsed > gaps_.period())
   {
     ++overruns_;
@@ -446,6 +452,18 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("window (s)", params_.health.diagnostic_window);
   status.add("processing time mean (ms)", mean_ms);
   status.add("processing time max (ms)", kMillisecondsPerSecond * window_processing_max_);
+  for (const auto& [q, label] : { std::pair<double, const char*>{ 0.5, " median (ms)" }, { 0.9, " p90 (ms)" } })
+  {
+    const double build = processing_samples_.quantile(now, q), age = cloud_to_published_.quantile(now, q);
+    if (std::isnan(build))
+      status.add(std::string("processing time") + label, "none");
+    else
+      status.add(std::string("processing time") + label, build);
+    if (std::isnan(age))
+      status.add(std::string("latency cloud to grid published") + label, "none");
+    else
+      status.add(std::string("latency cloud to grid published") + label, age);
+  }
   status.add("clouds received", counters_.clouds_received);
   status.add("clouds published", counters_.clouds_published);
   status.add("clouds rejected", counters_.clouds_rejected);

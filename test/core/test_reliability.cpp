@@ -103,6 +103,28 @@ TEST(TimeGuardParams, OutOfRangeNamesTheParameter)
   EXPECT_THROW(p.validate(), ParameterError);
 }
 
+TEST(SlidingSamples, NearestRankQuantilesOfTheWindowOnly)
+{
+  SlidingSamples s(5.0);
+  EXPECT_TRUE(std::isnan(s.quantile(0.0, 0.5))) << "no sample, no median";
+  // Ten samples 1..10 ms at t = 0.0 .. 0.9 s.
+  for (int k = 1; k <= 10; ++k) s.add(0.1 * (k - 1), k);
+  EXPECT_EQ(s.count(1.0), 10u);
+  EXPECT_EQ(s.quantile(1.0, 0.5), 5.0) << "the 5th of 10";
+  EXPECT_EQ(s.quantile(1.0, 0.9), 9.0) << "the 9th of 10";
+  EXPECT_EQ(s.quantile(1.0, 1.0), 10.0);
+  EXPECT_EQ(s.quantile(1.0, 0.0), 1.0);
+  // One slow sample later: the window keeps what it held.
+  s.add(2.0, 100.0);
+  EXPECT_EQ(s.quantile(2.0, 0.9), 10.0) << "the 10th of 11";
+  EXPECT_EQ(s.quantile(2.0, 1.0), 100.0);
+  // At t = 5.45 s the samples of t ≤ 0.45 s have left the window: 6, 7, 8, 9, 10, 100 remain.
+  EXPECT_EQ(s.count(5.45), 6u);
+  EXPECT_EQ(s.quantile(5.45, 0.5), 8.0);
+  EXPECT_EQ(s.count(7.0), 0u) << "the slow sample leaves too";
+  EXPECT_TRUE(std::isnan(s.quantile(7.0, 0.9)));
+}
+
 TEST(SlidingCounter, CountsOnlyTheWindowAndDecays)
 {
   SlidingCounter c(5.0);

@@ -3,7 +3,8 @@
 // the decisions have the configured size and that clouds are fused; reports the cloud stamp -> decision latency
 // (median, p90, max) and the clouds that produced no decision (speed is measured here, not asserted), and from the
 // nodelets' diagnostics (sampled while the clouds flow) where the time goes: the ScanGrid build, the MapGrid update
-// and the fusion callback with its outputs.
+// and the fusion callback with its outputs, and their windowed medians and p90s stage by stage, from the cloud's
+// stamp to its decision.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -36,10 +37,17 @@ double median(std::vector<double> v)
   return v[v.size() / 2];
 }
 
+/// The windowed latencies the nodelets' diagnostics report (median and p90 over their last window), by key.
+const char* const kWindowedKeys[] = { "latency cloud to grid published", "processing time",
+                                      "latency cloud to fusion callback", "stage conversion", "stage shift",
+                                      "stage project scan", "stage prior window", "stage fusion step",
+                                      "stage tracking", "stage outputs", "latency cloud to decision" };
+
 /// The diagnostics' stage times, one sample per diagnostics message while clouds flow.
 struct StageSamples
 {
   std::vector<double> scan_grid_ms, update_ms, callback_ms;
+  std::map<std::string, double> windowed;  ///< the last windowed median/p90 of each key (ms), while clouds flow
 
   void add(const diagnostic_msgs::DiagnosticArray& m)
   {
@@ -59,6 +67,11 @@ struct StageSamples
         {
         }
       }
+      if (endsWith(": ScanGrid") || endsWith(": fusion"))
+        for (const char* key : kWindowedKeys)
+          for (const char* q : { " median", " p90" })
+            for (const char* unit : { " [ms]", " (ms)" })
+              if (auto it = v.find(std::string(key) + q + unit); it != v.end()) windowed[std::string(key) + q] = it->second;
       if (endsWith(": ScanGrid") && v.count("processing time mean (ms)") && v["processing time mean (ms)"] > 0.0)
         scan_grid_ms.push_back(v["processing time mean (ms)"]);
       if (endsWith(": fusion") && v.count("time total with outputs [ms]") && v["time total with outputs [ms]"] > 0.0)
@@ -158,6 +171,21 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   std::cout << "stage medians over " << stages.callback_ms.size() << " diagnostics samples (ms): ScanGrid build "
             << median(stages.scan_grid_ms) << ", MapGrid update " << median(stages.update_ms)
             << ", fusion callback with outputs " << median(stages.callback_ms) << "\n";
+  std::cout << "where the time goes, the nodelets' windowed diagnostics at the end of the drive (ms, median / p90):\n";
+  for (const char* key : kWindowedKeys)
+  {
+    const auto med = stages.windowed.find(std::string(key) + " median");
+    const auto p90 = stages.windowed.find(std::string(key) + " p90");
+    if (med == stages.windowed.end() || p90 == stages.windowed.end()) continue;
+    std::cout << "  " << key << ": " << med->second << " / " << p90->second << "\n";
+    std::string property(key);
+    std::replace(property.begin(), property.end(), ' ', '_');
+    RecordProperty(property + "_median_ms", static_cast<int>(std::lround(med->second)));
+    RecordProperty(property + "_p90_ms", static_cast<int>(std::lround(p90->second)));
+  }
+  EXPECT_TRUE(stages.windowed.count("latency cloud to decision median")) << "the fusion reports its latency";
+  EXPECT_TRUE(stages.windowed.count("stage fusion step p90"));
+  EXPECT_TRUE(stages.windowed.count("processing time p90")) << "the ScanGrid reports its build time";
   RecordProperty("scan_grid_ms", static_cast<int>(std::lround(median(stages.scan_grid_ms))));
   RecordProperty("update_ms", static_cast<int>(std::lround(median(stages.update_ms))));
   RecordProperty("fusion_callback_ms", static_cast<int>(std::lround(median(stages.callback_ms))));

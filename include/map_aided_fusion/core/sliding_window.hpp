@@ -78,6 +78,55 @@ private:
   std::size_t total_ = 0;
 };
 
+/**
+ * @brief Values (a latency, a stage's time) recorded at times (seconds, any monotonic clock) in (now − span, now],
+ *        and their quantiles: what a stage took over the last few seconds, not since start.
+ *
+ * Memory is bounded by the samples of one span (older ones are pruned on every call).
+ */
+class SlidingSamples
+{
+public:
+  /// @param span window length, seconds (> 0)
+  explicit SlidingSamples(double span = 5.0) : span_(span) {}
+
+  void setSpan(double span) { span_ = span; }
+
+  /// Records @p value at time @p t.
+  void add(double t, double value)
+  {
+    samples_.push_back(Sample{ t, value });
+    prune(t);
+  }
+
+  /// Samples in (now − span, now].
+  std::size_t count(double now)
+  {
+    prune(now);
+    return samples_.size();
+  }
+
+  /**
+   * @brief The nearest-rank @p q-quantile (q in [0, 1]: 0.5 the median, 0.9 the p90) of the samples in
+   *        (now − span, now]: the smallest value with at least ⌈q·n⌉ samples at or below it; NaN without samples.
+   */
+  double quantile(double now, double q);
+
+private:
+  struct Sample
+  {
+    double t;
+    double value;
+  };
+  void prune(double now)
+  {
+    while (!samples_.empty() && samples_.front().t <= now - span_) samples_.pop_front();
+  }
+
+  double span_;
+  std::deque<Sample> samples_;
+};
+
 /// Parameters of the diagnostics of a node that expects a stream of scans (config/*.yaml).
 struct StreamHealthParams
 {

@@ -158,6 +158,15 @@ private:
   double last_fused_wall_ = 0.0;
   core::StageTimes last_times_;
   double last_total_seconds_ = 0.0;
+  /// Where a scan's time goes, ms, over the diagnostics window (issue: latency you can see): the cloud's age when
+  /// the callback starts (ScanGrid build, hand-over, tf wait) and when its decision is out, and each stage.
+  struct LatencyWindows
+  {
+    core::SlidingSamples cloud_to_callback, cloud_to_decision, conversion, shift, project_scan, prior_window, fusion,
+        tracking, outputs;
+    void setSpan(double span);
+  };
+  LatencyWindows latency_;
   double last_mean_conflict_ = 0.0;
   std::string last_reconfigure_ = "none";
 

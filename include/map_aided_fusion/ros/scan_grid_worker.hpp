@@ -134,6 +134,8 @@ private:
   // Diagnostics over the last health.diagnostic_window seconds (wall time).
   core::SlidingCounter received_window_, published_window_, rejected_window_, deskew_skipped_window_,
       ground_fallback_window_;
+  /// ms over the window: building a cloud's grid, and the cloud's age when its grid is published.
+  core::SlidingSamples processing_samples_, cloud_to_published_;
   double window_processing_sum_ = 0.0;
   double window_processing_max_ = 0.0;
   std::size_t window_processed_ = 0;
