@@ -33,13 +33,18 @@ constexpr double kScanPeriod = 0.1;
 constexpr double kSettle = 2.5;  // s: more than two diagnostic periods
 
 /// What the three nodelets report on /diagnostics, by status (name fragment) then key.
+/// Clouds the probe's publisher holds (more than Item13's burst of 61).
+constexpr int kPublisherQueue = 100;
+
 class Probe
 {
 public:
   Probe()
   {
     ros::NodeHandle nh;
-    points_ = nh.advertise<sensor_msgs::PointCloud2>("points", 20);
+    // Room for Item13's whole burst: clouds are lost in the ScanGrid's input queue, which is what it counts, not
+    // in this publisher's queue (a cloud dropped here only leaves a gap the ScanGrid sees while idle).
+    points_ = nh.advertise<sensor_msgs::PointCloud2>("points", kPublisherQueue);
     tf_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
     diagnostics_ = nh.subscribe("/diagnostics", 100, &Probe::onDiagnostics, this);
     decision_ = nh.subscribe("/map_aided_fusion/decision", 5, &Probe::onDecision, this);
