@@ -140,9 +140,8 @@ def main():
     if lies:
         parts.append("\n## Scenarios of a simulator that lies and of real-sensor effects\n\n")
         parts.append("`scenarios/<name>.yaml`; doc/steps.md says what each one tests.\n\n")
-        head = "| scenario | " + table({}, SIM_COLUMNS).splitlines()[0][len("| variant | "):] + "\n"
-        rule = "| --- | --- | " + " | ".join("---:" for _ in SIM_COLUMNS) + " |\n"
-        parts.append(head.replace("| scenario | ", "| scenario | profile | ", 1) + rule)
+        parts.append("| scenario | profile | " + " | ".join(c for c, _ in SIM_COLUMNS) + " |\n"
+                     "| --- | --- | " + " | ".join("---:" for _ in SIM_COLUMNS) + " |\n")
         for n, v in lies:
             for profile in ("default", "paper"):
                 if profile in v:
