@@ -21,6 +21,13 @@ namespace {
 
 constexpr int kMaxQueueSize = 1000;
 constexpr double kMillisecondsPerSecond = 1000.0;
+
+/// Stamps the steady time into @p end when the callback that holds it returns.
+struct MarkBusyEnd
+{
+  std::atomic<double>& end;
+  ~MarkBusyEnd() { end = core::steadySeconds(); }
+};
 constexpr double kMaxFutureTolerance = 3600.0;
 constexpr double kMinJumpThreshold = 0.001;
 constexpr double kMaxJumpThreshold = 3600.0;
@@ -173,17 +180,14 @@ void ScanGridWorker::checkClock()
              "buffer and the clouds waiting for a transform",
              params_.time_jump_threshold, now.toSec());
     tf_buffer_->clear();
+    pending_builds_ = 0;
   }
   tf_filter_->clear();
 }
 
 void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
-  struct MarkEnd
-  {
-    std::atomic<double>& end;
-    ~MarkEnd() { end = core::steadySeconds(); }
-  } mark_end{ last_callback_end_ };
+  const MarkBusyEnd mark_end{ last_busy_end_ };
   checkClock();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -218,7 +222,7 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
     if (const std::size_t lost = gaps_.observe(cloud->header.stamp.toSec()); lost > 0)
     {
       // Waiting idle for more than 1.5 periods means the queue was empty: the stream itself had the gap.
-      const double idle = core::steadySeconds() - last_callback_end_.load();
+      const double idle = core::steadySeconds() - last_busy_end_.load();
       if (idle > core::InputGapCounter::kLostGapFactor * gaps_.period())
       {
         stream_gaps_ += lost;
@@ -246,14 +250,30 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
       ++counters_.clouds_skipped;
       return;
     }
+    ++pending_builds_;
   }
   tf_filter_->add(cloud);
+}
+
+bool ScanGridWorker::takePendingBuild(const sensor_msgs::PointCloud2& cloud)
+{
+  if (pending_builds_ > 0) --pending_builds_;
+  if (pending_builds_ < static_cast<std::size_t>(params_.input_queue_size)) return true;
+  ++clouds_lost_;
+  lost_window_.add(core::steadySeconds(), 1);
+  ROS_WARN_THROTTLE(1.0, "scan_grid: a cloud on %s stamped %.3f dropped unbuilt: %zu newer clouds wait behind it "
+                         "(input_queue_size %d): processing is slower than the input; raise input_queue_size or "
+                         "lighten the load; %zu lost so far",
+                    cloud_sub_.getTopic().c_str(), cloud.header.stamp.toSec(), pending_builds_,
+                    params_.input_queue_size, clouds_lost_);
+  return false;
 }
 
 void ScanGridWorker::onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& cloud,
                                         tf2_ros::filter_failure_reasons::FilterFailureReason reason)
 {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (pending_builds_ > 0) --pending_builds_;
   const char* why = reason == tf2_ros::filter_failure_reasons::OutTheBack ? "older than the transform buffer" :
                     reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame_id" :
                                                                                "transform not available in time";
@@ -263,8 +283,10 @@ void ScanGridWorker::onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& 
 
 void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
+  const MarkBusyEnd mark_end{ last_busy_end_ };
   const ros::WallTime start = ros::WallTime::now();
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!takePendingBuild(*cloud)) return;
   Eigen::Isometry3d pose;
   try
   {

@@ -42,7 +42,7 @@ namespace map_aided_fusion {
 struct ScanGridNodeParams
 {
   std::string base_frame = "base_link";  ///< frame of the published grids
-  int input_queue_size = 2;              ///< clouds buffered by the subscriber (≥ 1)
+  int input_queue_size = 2;              ///< clouds waiting to be built: older ones are dropped and counted (≥ 1)
   int tf_queue_size = 10;                ///< clouds waiting for their transform (≥ 1)
   /// s a cloud may be stamped ahead of the clock (a late /clock is waited for), [0, 3600]
   double future_tolerance = 10.0;
@@ -67,7 +67,7 @@ template <class Get>
 void forEachParam(ScanGridNodeParams& p, Get&& get)
 {
   get("base_frame", p.base_frame, { "", "vehicle frame of the published grids" });
-  get("input_queue_size", p.input_queue_size, { "clouds", "clouds buffered by the subscriber" });
+  get("input_queue_size", p.input_queue_size, { "clouds", "clouds waiting to be built; older ones are dropped and counted" });
   get("tf_queue_size", p.tf_queue_size, { "clouds", "clouds waiting for their transform" });
   get("future_tolerance", p.future_tolerance, { "s", "a cloud may be stamped this far ahead of a lagging clock" });
   get("time_jump_threshold", p.time_jump_threshold, { "s", "ROS time going back by more than this is a jump (tf buffer cleared)" });
@@ -104,6 +104,9 @@ public:
 private:
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud);
   void onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr& cloud);
+  /// Takes @p cloud off the backlog; false (counted as lost in the input queue) when input_queue_size newer clouds
+  /// wait behind it, so that an overloaded node drops its oldest clouds instead of falling ever further behind.
+  bool takePendingBuild(const sensor_msgs::PointCloud2& cloud);
   void onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& cloud,
                           tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onReconfigure(ScanGridConfig& config, std::uint32_t level);
@@ -152,7 +155,11 @@ private:
   core::SlidingCounter lost_window_, overrun_window_, stream_gap_window_;
   std::size_t clouds_lost_ = 0, overruns_ = 0;
   std::size_t stream_gaps_ = 0;           ///< clouds missing from the stream while the node was idle (paused, skipped)
-  std::atomic<double> last_callback_end_{ 0.0 };  ///< steady time the last `points` callback returned
+  /// Steady time the last callback of the cloud path (the check in onCloud or the build) returned: a stamp gap
+  /// seen while the node was busy less than 1.5 periods before is a loss in the input queue.
+  std::atomic<double> last_busy_end_{ 0.0 };
+  /// Clouds handed to the tf filter and not yet built, dropped or cleared: the backlog input_queue_size bounds.
+  std::size_t pending_builds_ = 0;
   std::size_t reconfigure_refused_ = 0;
   std::string last_reconfigure_ = "none";
 
