@@ -32,7 +32,7 @@ if(CATKIN_ENABLE_TESTING)
 endif()
 
 if(TARGET bench_map_aided_fusion)
-  target_sources(bench_map_aided_fusion PRIVATE bench/bench_simulator.cpp)
+  target_sources(bench_map_aided_fusion PRIVATE bench/bench_simulator.cpp bench/bench_drive.cpp)
   target_link_libraries(bench_map_aided_fusion map_aided_fusion_sim)
   if(TARGET map_aided_fusion_map_io)
     target_link_libraries(bench_map_aided_fusion map_aided_fusion_map_io)

@@ -13,7 +13,10 @@ import sys
 BEGIN = "<!-- bench:begin (scripts/bench writes this table; do not edit) -->"
 END = "<!-- bench:end -->"
 
-# (benchmark, what it measures, reference benchmark or None): the ratio is median / median of the reference.
+DRIVE = "BM_MapGridUpdateDrive/n:{n}/threads:{t}/skip:{s}/iterations:200/real_time"
+
+# (benchmark, what it measures, reference benchmark or None[, counter shown after "what"]): the ratio is median /
+# median of the reference.
 ROWS = [
     ("BM_MapGridUpdate/n:200/threads:1/real_time", "the whole per-scan update, the paper's 100 m at 0.5 m (200 × 200)", None),
     ("BM_MapGridUpdate/n:200/threads:2/real_time", "the same, 2 threads", "BM_MapGridUpdate/n:200/threads:1/real_time"),
@@ -21,6 +24,12 @@ ROWS = [
     ("BM_MapGridUpdate/n:800/threads:2/real_time", "the same, 2 threads", "BM_MapGridUpdate/n:800/threads:1/real_time"),
     ("BM_MapGridUpdateReturns/n:800/threads:2/real_time", "the update with the scan's obstacle returns (the live default)", "BM_MapGridUpdate/n:800/threads:2/real_time"),
     ("BM_UpdateBaseline/n:800/threads:2/real_time", "the bytes the update cannot avoid, streamed once", "BM_MapGridUpdate/n:800/threads:2/real_time"),
+    (DRIVE.format(n=800, t=1, s=0), "the update on a realistic drive (32-beam lidar through the simulated town at 8 m/s, prior, 200 sweeps from an empty grid), 800 × 800, `skip_unchanged` off", None),
+    (DRIVE.format(n=800, t=1, s=1), "the same with `skip_unchanged` (the default)", DRIVE.format(n=800, t=1, s=0), "skipped_share"),
+    (DRIVE.format(n=800, t=2, s=0), "the realistic drive, 2 threads, `skip_unchanged` off", None),
+    (DRIVE.format(n=800, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=800, t=2, s=0), "skipped_share"),
+    (DRIVE.format(n=200, t=2, s=0), "the realistic drive, 200 × 200 at 0.5 m, 2 threads, `skip_unchanged` off", None),
+    (DRIVE.format(n=200, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=200, t=2, s=0), "skipped_share"),
     ("BM_FusionStep/n:800/threads:2/real_time", "the fused step alone (refine, prior, discounting, ⊛, counter, BetP)", "BM_MapGridUpdate/n:800/threads:2/real_time"),
     ("BM_StreamBaseline/n:800/threads:2/real_time", "the fused step's bytes, streamed once", "BM_FusionStep/n:800/threads:2/real_time"),
     ("BM_ProjectScan/clearance:5/threads:2/real_time", "the scan's projection with a 1 m obstacle clearance", "BM_MapGridUpdate/n:800/threads:2/real_time"),
@@ -35,13 +44,18 @@ ROWS = [
 ]
 
 
-def medians(data):
+def median_runs(data):
+    """The median aggregate (or the single run) of each benchmark, by run name."""
     out = {}
     for b in data["benchmarks"]:
         if b.get("aggregate_name") == "median" or ("aggregate_name" not in b and b["run_type"] == "iteration"):
-            unit = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b.get("time_unit", "ns")]
-            out[b["run_name"] if "run_name" in b else b["name"]] = b["real_time"] * unit
+            out[b["run_name"] if "run_name" in b else b["name"]] = b
     return out
+
+
+def medians(data):
+    unit = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+    return {k: b["real_time"] * unit[b.get("time_unit", "ns")] for k, b in median_runs(data).items()}
 
 
 def table(data):
@@ -49,17 +63,24 @@ def table(data):
     reps = max((b.get("repetitions", 1) for b in data["benchmarks"]), default=1)
     cpu = ctx.get("mhz_per_cpu")
     m = medians(data)
+    runs = median_runs(data)
     lines = [f"Machine: {ctx.get('host_name', '?')}, {ctx.get('num_cpus', '?')} CPUs at {cpu} MHz "
              f"({cpu_model()}); medians of {reps} repetitions, real time, ms; the ratio is the median over its "
              f"reference's median in the same run. Written by `scripts/bench` on {ctx.get('date', '?')[:10]}.", "",
              "| benchmark | what | median (ms) | ratio | to |", "| --- | --- | ---: | ---: | --- |"]
-    for name, what, ref in ROWS:
+    for name, what, ref, *counter in ROWS:
         if name not in m:
             continue
+        if counter and counter[0] in runs[name]:
+            what += f"; {counter[0].replace('_', ' ')} {runs[name][counter[0]]:.2f}"
         ratio = f"{m[name] / m[ref]:.2f}" if ref and ref in m else ""
-        lines.append(f"| `{name.replace('/real_time', '')}` | {what} | {m[name]:.3f} | {ratio} | "
-                     f"{'`' + ref.replace('/real_time', '') + '`' if ref and ref in m else ''} |")
+        lines.append(f"| `{short(name)}` | {what} | {m[name]:.3f} | {ratio} | "
+                     f"{'`' + short(ref) + '`' if ref and ref in m else ''} |")
     return "\n".join(lines) + "\n"
+
+
+def short(name):
+    return name.replace("/real_time", "").replace("/iterations:200", "")
 
 
 def cpu_model():

@@ -133,6 +133,13 @@ void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, co
   in.decision = nullptr;
   in.seeds = nullptr;
   in.first = 0;
+  in.stable = nullptr;
+  for (float*& k : in.kept) k = nullptr;
+  if (decisions && decisions->skip && decisions->skip->stable)
+  {
+    in.stable = decisions->skip->stable;
+    for (int k = 0; k < 4; ++k) in.kept[k] = decisions->skip->kept[k];
+  }
   if (decisions && (decisions->out || decisions->motion_seeds))
   {
     if (!betp) throw std::invalid_argument("fusionStep: decisions need the BetP planes");
@@ -180,6 +187,7 @@ void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, co
     sum.sum_conflict_occupied_free += s.sum_conflict_occupied_free;
     sum.sum_conflict_other += s.sum_conflict_other;
     sum.num_cells += s.num_cells;
+    sum.num_skipped += s.num_skipped;
   };
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
@@ -217,6 +225,7 @@ void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, co
     total.sum_conflict_occupied_free += p.sum_conflict_occupied_free;
     total.sum_conflict_other += p.sum_conflict_other;
     total.num_cells += p.num_cells;
+    total.num_skipped += p.num_skipped;
   }
   if (stats) *stats = total;
 }

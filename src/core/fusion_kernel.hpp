@@ -50,6 +50,9 @@ struct StepInputs
   DecisionRule decision_rule;
   std::vector<std::size_t>* seeds;  ///< motion spreading's seeds to append (with BetP only), or nullptr
   std::size_t first;                ///< index of the first cell in the whole grid (what the seeds record)
+  /// StepSkip's flags and kept prior, indexed from the whole grid's first cell (first + i), or nullptr.
+  std::uint8_t* stable;
+  float* kept[4];
 
   /// The same inputs for the cells [begin, begin + count): every per-cell pointer moved. @p begin must start a block
   /// of the MapGrid (a multiple of MapMassGrid::kBlockCells). The prior pointers are the caller's (rows of the prior).

@@ -122,9 +122,11 @@ std::size_t MapGridParams::bytesPerCell()
   const std::size_t planes = (MapMassGrid::kNumPlanes + 1)  // the stored masses and ζ
                              + FrameMG::kSize              // BetP
                              + 4                           // the prior window (building, road, other, wall)
-                             + 1;                          // the map doubt η
+                             + 1                           // the map doubt η
+                             + 4;                          // skip_unchanged: the prior each stable block kept
   constexpr std::size_t kProjectionMasks = 3;              // ScanProjection: occupied, near by row, near
-  return planes * sizeof(float) + sizeof(std::int8_t) /* the decision */ + kProjectionMasks;
+  constexpr std::size_t kStableFlag = 1;                   // skip_unchanged: one flag per block, counted per cell
+  return planes * sizeof(float) + sizeof(std::int8_t) /* the decision */ + kProjectionMasks + kStableFlag;
 }
 
 double MapGridParams::bytesNeeded() const
@@ -487,6 +489,7 @@ void MapGrid::setParams(const MapGridParams& params)
   if (!parallel_ || parallel_->threads() != resolveThreads(params.threads))
     parallel_ = std::make_shared<const Parallel>(params.threads);
   params_ = params;
+  forgetStable();
   if (realloc)
   {
     grid_.reset(g);
@@ -499,6 +502,7 @@ void MapGrid::setParams(const MapGridParams& params)
 
 void MapGrid::reset()
 {
+  forgetStable();
   grid_.fillVacuous();
   std::fill(map_doubt_.begin(), map_doubt_.end(), 0.0f);
   pignisticGrid(grid_, betp_);
@@ -606,6 +610,7 @@ void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par)
 void MapGrid::shift(int dx, int dy)
 {
   if (dx == 0 && dy == 0) return;
+  forgetStable();  // BetP and the decisions stay where they were until the next step writes them
   const GridGeometry g = grid_.geometry();
   grid_.setOrigin(g.origin_x + dx * g.resolution, g.origin_y + dy * g.resolution);
   if (std::abs(dx) >= g.width || std::abs(dy) >= g.height)
@@ -718,6 +723,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   auto t0 = std::chrono::steady_clock::now();
   if (scans_ == 0)
   {
+    forgetStable();
     grid_.fillVacuous();
     const Point2 o = snappedOrigin(grid_.geometry(), Point2{ pose.x, pose.y });
     grid_.setOrigin(o.x, o.y);
@@ -773,10 +779,14 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   decisions.threshold = params_.decision_threshold;
   decisions.motion_margin = params_.motion_margin;
   if (params_.motion_share > 0.0) decisions.motion_seeds = &motion_seeds_;
+  StepSkip skip;
+  decisions.skip = prepareSkip(step_prior.grid != nullptr, step_prior.doubt != nullptr, skip);
   fusionStep(grid_, projection_, step_prior, fp, &stats, &betp_, parallel_.get(), &decisions);
+  skipped_share_ = grid_.numCells() > 0 ? static_cast<double>(stats.num_skipped) / grid_.numCells() : 0.0;
   const std::vector<std::size_t>* spread = nullptr;
   spreadMotionCells(grid_, betp_, projection_.occupied().data(), params_.motion_share, params_.motion_max_cells,
                     params_.decision_threshold, params_.motion_margin, parallel_.get(), &motion_seeds_, spread);
+  forgetStable(*spread);
   redecide(grid_, betp_, params_, *spread, decision_);
   t.fusion = secondsSince(t0);
 
@@ -784,6 +794,36 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   ++scans_;
   if (times) *times = t;
   return stats;
+}
+
+const StepSkip* MapGrid::prepareSkip(bool has_prior, bool has_doubt, StepSkip& skip)
+{
+  if (!params_.skip_unchanged || params_.rates_per_second)
+  {
+    stable_.clear();
+    for (auto& k : kept_) AlignedVector<float>().swap(k);
+    skip_inputs_ = -1;
+    return nullptr;
+  }
+  const std::size_t n = grid_.numCells();
+  const std::size_t blocks = (n + MapMassGrid::kBlockCells - 1) / MapMassGrid::kBlockCells;
+  const int inputs = (has_prior ? 2 : 0) + (has_doubt ? 1 : 0);
+  if (stable_.size() != blocks || inputs != skip_inputs_)
+  {
+    stable_.assign(blocks, 0);
+    for (auto& k : kept_) k.resize(n);
+    skip_inputs_ = inputs;
+  }
+  skip.stable = stable_.data();
+  for (int k = 0; k < 4; ++k) skip.kept[k] = kept_[k].data();
+  return &skip;
+}
+
+void MapGrid::forgetStable(const std::vector<std::size_t>& cells)
+{
+  if (stable_.empty()) return;
+  for (const std::size_t i : cells)
+    if (i / MapMassGrid::kBlockCells < stable_.size()) stable_[i / MapMassGrid::kBlockCells] = 0;
 }
 
 void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
@@ -797,6 +837,7 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
   {
     if (c.cell >= n) continue;
     changed.push_back(c.cell);
+    if (!stable_.empty()) stable_[c.cell / MapMassGrid::kBlockCells] = 0;
     if (c.motion != CellClass::kMoving && c.motion != CellClass::kStopped) continue;
     const float beta = std::clamp(c.weight, 0.0f, 1.0f);
     if (!(beta > 0.0f)) continue;

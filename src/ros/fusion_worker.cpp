@@ -368,7 +368,7 @@ void FusionWorker::checkClock()
 void FusionWorker::LatencyWindows::setSpan(double span)
 {
   for (core::SlidingSamples* w : { &cloud_to_callback, &cloud_to_decision, &conversion, &shift, &project_scan,
-                                   &prior_window, &fusion, &tracking, &outputs })
+                                   &prior_window, &fusion, &tracking, &outputs, &skipped })
     w->setSpan(span);
 }
 
@@ -546,6 +546,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   latency_.project_scan.add(now, kMillisecondsPerSecond * times.project_scan);
   latency_.prior_window.add(now, kMillisecondsPerSecond * times.prior_window);
   latency_.fusion.add(now, kMillisecondsPerSecond * times.fusion);
+  latency_.skipped.add(now, grid_.skippedShare());
   latency_.tracking.add(now, ms(tracking_start, outputs_start));
   latency_.outputs.add(now, ms(outputs_start, end));
 }
@@ -698,6 +699,11 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   quantiles("stage fusion step", latency_.fusion);
   quantiles("stage tracking", latency_.tracking);
   quantiles("stage outputs", latency_.outputs);
+  const double skipped = latency_.skipped.quantile(now, 0.5);
+  if (std::isnan(skipped))
+    status.add("cells skipped (skip_unchanged) median [share]", "none");
+  else
+    status.add("cells skipped (skip_unchanged) median [share]", skipped);
   status.add("mean conflict", last_mean_conflict_);
   status.add("memory [MiB]", grid_.params().bytesNeeded() / (1024.0 * 1024.0));
   status.add("prior", softener_.raw() ? "received" : "none (vacuous)");

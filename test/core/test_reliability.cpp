@@ -163,7 +163,7 @@ TEST(StreamHealth, WarnsAndErrsWhenScansStopAndRecovers)
 TEST(MemoryBudget, HugeWindowIsRefusedBeforeAllocationWithTheBytesNeeded)
 {
   // 29 stored focal sets and ζ, BetP, the prior window (4), the map doubt; the decision; the projection's 3 masks.
-  EXPECT_EQ(MapGridParams::bytesPerCell(), (29u + 1u + 5u + 4u + 1u) * sizeof(float) + 1u + 3u);
+  EXPECT_EQ(MapGridParams::bytesPerCell(), (29u + 1u + 5u + 4u + 1u + 4u) * sizeof(float) + 1u + 3u + 1u);
   MapGridParams p;
   p.size_x = p.size_y = 4096.0;  // 8192 x 8192 cells at 0.5 m: 12 GB
   try

@@ -37,6 +37,9 @@ double median(std::vector<double> v)
   return v[v.size() / 2];
 }
 
+/// The share of cells the fusion's step skipped, windowed median.
+constexpr const char* kSkippedKey = "cells skipped (skip_unchanged) median [share]";
+
 /// The windowed latencies the nodelets' diagnostics report (median and p90 over their last window), by key.
 const char* const kWindowedKeys[] = { "latency cloud to grid published", "processing time",
                                       "latency cloud to fusion callback", "stage conversion", "stage shift",
@@ -48,6 +51,7 @@ struct StageSamples
 {
   std::vector<double> scan_grid_ms, update_ms, callback_ms;
   std::map<std::string, double> windowed;  ///< the last windowed median/p90 of each key (ms), while clouds flow
+  double skipped_share = -1.0;              ///< the last kSkippedKey
 
   void add(const diagnostic_msgs::DiagnosticArray& m)
   {
@@ -72,6 +76,7 @@ struct StageSamples
           for (const char* q : { " median", " p90" })
             for (const char* unit : { " [ms]", " (ms)" })
               if (auto it = v.find(std::string(key) + q + unit); it != v.end()) windowed[std::string(key) + q] = it->second;
+      if (auto it = v.find(kSkippedKey); it != v.end()) skipped_share = it->second;
       if (endsWith(": ScanGrid") && v.count("processing time mean (ms)") && v["processing time mean (ms)"] > 0.0)
         scan_grid_ms.push_back(v["processing time mean (ms)"]);
       if (endsWith(": fusion") && v.count("time total with outputs [ms]") && v["time total with outputs [ms]"] > 0.0)
@@ -183,6 +188,9 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
     RecordProperty(property + "_median_ms", static_cast<int>(std::lround(med->second)));
     RecordProperty(property + "_p90_ms", static_cast<int>(std::lround(p90->second)));
   }
+  std::cout << "  cells the fused step skipped (skip_unchanged), median share: " << stages.skipped_share << "\n";
+  RecordProperty("skipped_share_percent", static_cast<int>(std::lround(100.0 * stages.skipped_share)));
+  EXPECT_GE(stages.skipped_share, 0.0) << "the fusion reports " << kSkippedKey;
   EXPECT_TRUE(stages.windowed.count("latency cloud to decision median")) << "the fusion reports its latency";
   EXPECT_TRUE(stages.windowed.count("stage fusion step p90"));
   EXPECT_TRUE(stages.windowed.count("processing time p90")) << "the ScanGrid reports its build time";

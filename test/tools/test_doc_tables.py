@@ -95,3 +95,19 @@ def test_bench_table_gives_ratios_within_one_run(tmp_path):
     text = doc.read_text()
     assert "| `BM_MapGridUpdate/n:800/threads:2` | the same, 2 threads | 12.500 | 0.62 | `BM_MapGridUpdate/n:800/threads:1` |" in text
     assert "medians of 5 repetitions" in text and "2 CPUs" in text and "old" not in text
+
+
+def test_bench_table_shows_the_drive_counter(tmp_path):
+    drive = "BM_MapGridUpdateDrive/n:800/threads:2/skip:{}/iterations:200/real_time"
+    data = {"context": {"host_name": "h", "num_cpus": 2, "mhz_per_cpu": 2000, "date": "2026-12-03T10:00:00"},
+            "benchmarks": [
+                {"name": drive.format(0) + "_median", "run_name": drive.format(0), "run_type": "aggregate",
+                 "aggregate_name": "median", "real_time": 10.0, "time_unit": "ms", "repetitions": 3, "skipped_share": 0.0},
+                {"name": drive.format(1) + "_median", "run_name": drive.format(1), "run_type": "aggregate",
+                 "aggregate_name": "median", "real_time": 8.0, "time_unit": "ms", "repetitions": 3, "skipped_share": 0.456},
+            ]}
+    path = tmp_path / "bench.json"
+    path.write_text(json.dumps(data))
+    out = subprocess.run([sys.executable, BENCH, str(path)], check=True, capture_output=True, text=True).stdout
+    assert ("| `BM_MapGridUpdateDrive/n:800/threads:2/skip:1` | the same with `skip_unchanged`; skipped share 0.46 | "
+            "8.000 | 0.80 | `BM_MapGridUpdateDrive/n:800/threads:2/skip:0` |") in out

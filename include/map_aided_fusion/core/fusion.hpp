@@ -86,10 +86,29 @@ struct FusionStepStats
   double sum_conflict_occupied_free = 0.0;  ///< Σ ∅_OF over cells
   double sum_conflict_other = 0.0;          ///< Σ remaining conflict over cells
   std::size_t num_cells = 0;
+  std::size_t num_skipped = 0;  ///< cells of num_cells the step left as they were without computing them (StepSkip)
   double meanConflict() const
   {
     return num_cells ? (sum_conflict_free_occupied + sum_conflict_occupied_free + sum_conflict_other) / num_cells : 0.0;
   }
+};
+
+/**
+ * @brief What fusionStep() needs to skip, bit-exactly, the cells the step would leave as they are
+ *        (MapGridParams::skip_unchanged).
+ *
+ * One flag per block of MapMassGrid::kBlockCells cells: a step sets it when it left the block's masses, ζ and map
+ * doubt η bit for bit as they were, under a vacuous scan (m(F) = m(O) = 0, m(Ω) = 1) and with no conflict, and keeps
+ * in @ref kept the prior it read there (0 where there is none). A later step skips a flagged block while its scan is
+ * vacuous and its prior the same bits: the step, a function of those inputs and the parameters, would give the same
+ * bits again. BetP and the decisions of a skipped block stay what that step wrote. The caller clears the flags of
+ * every cell it changes between steps, and all of them when the parameters, the window's place, the outputs asked
+ * for, or whether there is a prior or a map doubt change.
+ */
+struct StepSkip
+{
+  std::uint8_t* stable = nullptr;  ///< (cells + kBlockCells − 1) / kBlockCells flags
+  float* kept[4] = {};             ///< building, road, other and wall of the prior, one per cell
 };
 
 /// The decisions fusionStep() can write in the pass that computes BetP: the rule of decide() in map_grid.hpp.
@@ -101,6 +120,8 @@ struct StepDecisions
   /// When not null, also the cells that seed motion spreading (see spreadMotion() in map_grid.hpp, with this threshold
   /// and margin): one list per chunk of kFusionChunkCells cells, in index order.
   std::vector<std::vector<std::size_t>>* motion_seeds = nullptr;
+  /// When not null, blocks the step would leave as they are are skipped (see StepSkip).
+  const StepSkip* skip = nullptr;
 };
 
 /**

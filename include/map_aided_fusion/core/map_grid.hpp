@@ -5,6 +5,7 @@
  */
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -106,6 +107,13 @@ struct MapGridParams
    * [0, kMaxThreads]; 0: every core. The results are bit-identical for any value (parallel.hpp).
    */
   int threads = 0;
+  /**
+   * Skip, in the fused step, the blocks of cells the step would leave bit for bit as they are (StepSkip in
+   * fusion.hpp): cells the scan does not see whose evidence has reached a fixed point of the prior and the
+   * discounting, or is vacuous. Every output is bit-identical either way; off with alpha_per_second (the discounting
+   * then changes with each scan's Δt).
+   */
+  bool skip_unchanged = true;
   /// Bytes one window cell needs in the MapGrid and its per-scan buffers.
   static std::size_t bytesPerCell();
   /// Bytes the window of these parameters needs (cells × bytesPerCell()).
@@ -155,6 +163,7 @@ void forEachParam(MapGridParams& p, Get&& get)
   get("map_conflict_gain", p.map_conflict_gain, { "", "step: growth of the per-cell map doubt η where the scan contradicts the map; 0: off" });
   get("position_sigma", p.position_sigma, { "m", "σ of the vehicle position that softens the prior when no pose covariance is received" });
   get("threads", p.threads, { "", "threads of the per-scan update; 0: every core (results identical for any value)" });
+  get("skip_unchanged", p.skip_unchanged, { "", "skip the cells the step would leave bit for bit as they are (results identical either way)" });
 }
 
 /// Wall time of each stage of MapGrid::update(), seconds.
@@ -307,7 +316,14 @@ public:
   void recentre(Point2 p);
 
   const MapMassGrid& masses() const { return grid_; }
-  MapMassGrid& masses() { return grid_; }
+  /// The masses to change in place: the next update() computes every cell again (MapGridParams::skip_unchanged).
+  MapMassGrid& masses()
+  {
+    forgetStable();
+    return grid_;
+  }
+  /// Share of the last update's cells that skip_unchanged skipped, in [0, 1].
+  double skippedShare() const { return skipped_share_; }
   const GridGeometry& geometry() const { return grid_.geometry(); }
   /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
   const PignisticPlanes& pignistic() const { return betp_; }
@@ -351,6 +367,16 @@ private:
   std::shared_ptr<const Parallel> parallel_;
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;
+  // MapGridParams::skip_unchanged: StepSkip's flags and kept prior, and the step inputs they hold for (prior, doubt).
+  std::vector<std::uint8_t> stable_;
+  AlignedVector<float> kept_[4];
+  int skip_inputs_ = -1;
+  double skipped_share_ = 0.0;
+
+  void forgetStable() { std::fill(stable_.begin(), stable_.end(), std::uint8_t{ 0 }); }
+  void forgetStable(const std::vector<std::size_t>& cells);
+  /// The StepSkip of this update (flags sized, cleared when the inputs' kind changed), or nullptr when it is off.
+  const StepSkip* prepareSkip(bool has_prior, bool has_doubt, StepSkip& skip);
 };
 
 }  // namespace core

@@ -164,6 +164,7 @@ private:
   {
     core::SlidingSamples cloud_to_callback, cloud_to_decision, conversion, shift, project_scan, prior_window, fusion,
         tracking, outputs;
+    core::SlidingSamples skipped;  ///< share of the window's cells the step skipped (MapGridParams::skip_unchanged)
     void setSpan(double span);
   };
   LatencyWindows latency_;

@@ -1,0 +1,146 @@
+// MapGrid::update() on a realistic drive: 20 s through the simulator's town at 8 m/s with a 32-beam lidar and 40
+// objects, each sweep turned into a ScanGrid by the ScanGridBuilder (so the scan observes what such a lidar sees, a
+// few per cent of the window), with the town's PriorGrid, as the live default runs it (obstacle returns). Each
+// repetition is the whole drive from an empty MapGrid; skipped_share is the share of cells MapGridParams::
+// skip_unchanged left alone, on average over the drive.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "../test/sim/town_fixture.hpp"
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/prior_grid.hpp"
+#include "map_aided_fusion/core/prior_uncertainty.hpp"
+#include "map_aided_fusion/core/scan_grid.hpp"
+#include "map_aided_fusion/sim/simulator.hpp"
+
+using namespace map_aided_fusion;
+using namespace map_aided_fusion::core;
+
+namespace {
+
+constexpr double kDriveSeconds = 20.0;
+constexpr double kPriorMargin = 100.0;  // m of prior around the town: the window stays inside it
+
+/// One sweep of the drive, ready for MapGrid::update().
+struct DriveScan
+{
+  ScanMassGrid scan;
+  std::vector<float> obstacles;  // x, y pairs in base_link
+  Pose2 pose;
+  double time = 0.0;
+};
+
+struct Drive
+{
+  std::vector<DriveScan> scans;
+  std::shared_ptr<PriorWindow> prior;
+};
+
+/// The drive at @p resolution (scan grid and prior), built once per resolution.
+const Drive& drive(double resolution)
+{
+  static std::map<double, Drive> cache;
+  auto it = cache.find(resolution);
+  if (it != cache.end()) return it->second;
+  sim::Scenario sc;
+  sc.duration = kDriveSeconds;
+  sc.lidar = sim::LidarParams::fromPreset("vlp32");
+  sc.ego.route = { { -130.0, -1.5 }, { 1.75, -1.5 }, { 1.75, 78.25 }, { 80.0, 78.25 } };
+  sc.ego.motion.speed = 8.0;
+  for (int i = 0; i < 40; ++i)
+  {
+    sim::ObjectSpec o;
+    sim::objectKindDefaults(i % 4 == 0 ? "pedestrian" : "car", o);
+    o.id = static_cast<std::uint32_t>(i + 1);
+    const double x = -140.0 + 7.0 * i;
+    o.path = { { x, i % 2 ? 1.5 : -4.0 }, { x + 200.0, i % 2 ? 1.5 : -4.0 } };
+    o.motion.speed = i % 3 == 0 ? 0.0 : 8.0;
+    sc.objects.push_back(o);
+  }
+  const VectorMap map = maf_test::townLikeMap();
+  sim::Simulator simulator(sc, map);
+  Drive d;
+  const PriorGrid grid = PriorGrid::fromVectorMap(map, resolution, kPriorMargin, nullptr, PriorCellTest::kCoverage);
+  d.prior = std::make_shared<PriorWindow>();
+  mapPrior(grid, grid.geometry(), PriorConfidence{}, PriorGridOptions{}, *d.prior);
+  ScanGridParams sp;
+  sp.grid_resolution = resolution;
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.translation() << sc.lidar.mount_x, sc.lidar.mount_y, sc.lidar.mount_z;
+  ScanGridBuilder builder(sp, mount);
+  sim::ScanFrame frame;
+  for (int k = 0; k < simulator.numScans(); ++k)
+  {
+    simulator.scan(k, frame);
+    DriveScan s;
+    builder.build(PointCloudView::packed(frame.points.data(), frame.points.size(), sizeof(sim::LidarPoint)), s.scan);
+    const ObstaclePoints o = builder.obstaclePoints();
+    s.obstacles.assign(o.xy, o.xy + 2 * o.count);
+    s.pose = Pose2{ frame.ego.x, frame.ego.y, frame.ego.yaw };
+    s.time = frame.time;
+    d.scans.push_back(std::move(s));
+  }
+  return cache.emplace(resolution, std::move(d)).first->second;
+}
+
+/// Args: N (cells per side: 200 at 0.5 m, 800 at 0.2 m), threads, skip_unchanged (0 or 1).
+void BM_MapGridUpdateDrive(benchmark::State& state)
+{
+  const int n = static_cast<int>(state.range(0));
+  const double res = n == 200 ? 0.5 : 0.2;
+  const Drive& d = drive(res);
+  MapGridParams params;
+  params.threads = static_cast<int>(state.range(1));
+  params.skip_unchanged = state.range(2) != 0;
+  params.size_x = params.size_y = n * res;
+  params.resolution = res;
+  MapGrid grid(params);
+  std::size_t k = 0;
+  double skipped = 0.0;
+  StageTimes sum;
+  for (auto _ : state)
+  {
+    const DriveScan& s = d.scans[k];
+    const ObstaclePoints obstacles{ s.obstacles.data(), s.obstacles.size() / 2 };
+    StageTimes t;
+    grid.update(s.scan, s.pose, s.time, d.prior.get(), &t, &obstacles);
+    sum.shift += t.shift;
+    sum.project_scan += t.project_scan;
+    sum.prior_window += t.prior_window;
+    sum.fusion += t.fusion;
+    skipped += grid.skippedShare();
+    benchmark::ClobberMemory();
+    if (++k == d.scans.size())
+    {
+      k = 0;
+      state.PauseTiming();
+      grid.reset();
+      state.ResumeTiming();
+    }
+  }
+  const double per_scan = 1.0 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  state.counters["skipped_share"] = skipped * per_scan;
+  // Mean milliseconds per scan of each stage (as BM_MapGridUpdate's).
+  state.counters["shift_ms"] = 1e3 * sum.shift * per_scan;
+  state.counters["project_ms"] = 1e3 * sum.project_scan * per_scan;
+  state.counters["prior_ms"] = 1e3 * sum.prior_window * per_scan;
+  state.counters["fusion_ms"] = 1e3 * sum.fusion * per_scan;
+  state.counters["scans"] = static_cast<double>(d.scans.size());
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n) * n);
+}
+
+}  // namespace
+
+// One repetition is the whole drive (200 sweeps) from an empty grid.
+BENCHMARK(BM_MapGridUpdateDrive)
+    ->ArgsProduct({ { 200, 800 }, { 1, 2 }, { 0, 1 } })
+    ->ArgNames({ "n", "threads", "skip" })
+    ->Iterations(static_cast<std::int64_t>(kDriveSeconds * 10.0))
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);

@@ -1,0 +1,172 @@
+// MapGridParams::skip_unchanged: a drive with the skip and the same drive without it give the same bytes after every
+// scan (masses, ζ, BetP, map doubt, decisions, conflict sums), for the default and the paper profiles, with and
+// without a prior, across recentring, a prior that arrives late, tracked motion written between scans and masses
+// changed through masses(); and the skip does skip (most of the window once the unseen cells reach their fixed
+// point), nothing with alpha_per_second or when it is off.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/prior.hpp"
+#include "map_aided_fusion/core/profiles.hpp"
+
+using namespace map_aided_fusion::core;
+
+namespace {
+
+constexpr int kScans = 60;
+constexpr double kWindow = 48.0;       // m
+constexpr double kResolution = 0.25;   // m: 192 × 192 cells, several chunks of the step
+constexpr double kSeenRadius = 9.0;    // m around the vehicle the scan observes
+
+/// Everything a MapGrid holds after a scan, as raw bytes.
+struct Snapshot
+{
+  std::vector<float> planes, betp, doubt;
+  std::vector<std::int8_t> decision;
+  std::vector<double> conflicts;
+  bool operator==(const Snapshot& o) const
+  {
+    auto same = [](const auto& a, const auto& b) {
+      return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+    };
+    return same(planes, o.planes) && same(betp, o.betp) && same(doubt, o.doubt) && same(decision, o.decision) &&
+           same(conflicts, o.conflicts);
+  }
+};
+
+Snapshot snapshot(const MapGrid& grid, const FusionStepStats& s)
+{
+  Snapshot r;
+  const MapMassGrid& m = grid.masses();
+  r.planes.assign(m.planes(), m.planes() + m.bytes() / sizeof(float));
+  for (int e = 0; e < FrameMG::kSize; ++e)
+    r.betp.insert(r.betp.end(), grid.pignistic()[e].begin(), grid.pignistic()[e].end());
+  r.doubt.assign(grid.mapDoubt().begin(), grid.mapDoubt().end());
+  r.decision = grid.decisions();
+  r.conflicts = { s.sum_conflict_free_occupied, s.sum_conflict_occupied_free, s.sum_conflict_other };
+  return r;
+}
+
+enum class PriorKind
+{
+  kNone,
+  kAlways,
+  kFromScan20
+};
+
+struct Drive
+{
+  std::vector<Snapshot> after;      ///< after each scan
+  std::vector<double> skipped;      ///< MapGrid::skippedShare() after each scan
+};
+
+/// A drive whose scans see a disc around the vehicle (free, with a few occupied cells that move), the vehicle
+/// driving, stopping, then driving again (so that the window recentres), tracked motion written on unseen cells and
+/// one write through masses().
+Drive drive(MapGridParams params, bool skip, PriorKind prior_kind)
+{
+  params.size_x = params.size_y = kWindow;
+  params.resolution = kResolution;
+  params.recentre_distance = 3.0;
+  params.skip_unchanged = skip;
+  MapGrid grid(params);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> kind(0, 99);
+  PriorWindow prior(GridGeometry::centred(200.0, 200.0, kResolution));
+  for (std::size_t i = 0; i < prior.building.size(); ++i)
+  {
+    const int k = kind(rng);
+    (k < 40 ? prior.road : k < 70 ? prior.other : k < 90 ? prior.building : prior.wall)[i] = 0.8f;
+  }
+  const GridGeometry sg = GridGeometry::centred(kWindow, kWindow, kResolution);
+  Drive d;
+  Pose2 pose;
+  for (int step = 0; step < kScans; ++step)
+  {
+    const bool moving = step < 15 || step >= 45;
+    if (moving) pose.x += 0.6;
+    ScanMassGrid scan(sg);
+    for (std::size_t i = 0; i < scan.numCells(); ++i)
+    {
+      const Point2 c = sg.cellCentre(sg.cellOf(i));
+      if (c.x * c.x + c.y * c.y > kSeenRadius * kSeenRadius) continue;
+      const bool object = std::abs(c.y - 3.0) < 0.8 && std::abs(c.x - 4.0 + 0.3 * (step % 10)) < 1.5;
+      scan.setCell(i, object ? MassSG{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } } :
+                               MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } });
+    }
+    const bool with_prior = prior_kind == PriorKind::kAlways || (prior_kind == PriorKind::kFromScan20 && step >= 20);
+    const FusionStepStats s = grid.update(scan, pose, 0.1 * step, with_prior ? &prior : nullptr);
+    if (step == 30)
+    {
+      // Tracked motion on cells far from the vehicle (stable by now), then a write through masses().
+      std::vector<CellMotion> cells;
+      for (std::size_t i = 0; i < 200; ++i)
+        cells.push_back(CellMotion{ i * 37 % grid.masses().numCells(), i % 3 ? CellClass::kMoving : CellClass::kStopped,
+                                    0.5f });
+      grid.applyTrackedMotion(cells);
+    }
+    if (step == 40) grid.masses().setCell(5, MassMG{ { FrameMG::kC, 0.5 }, { FrameMG::kOmega, 0.5 } });
+    d.after.push_back(snapshot(grid, s));
+    d.skipped.push_back(grid.skippedShare());
+  }
+  return d;
+}
+
+void expectSameDrives(const MapGridParams& params, PriorKind prior, const std::string& what)
+{
+  const Drive off = drive(params, false, prior), on = drive(params, true, prior);
+  ASSERT_EQ(off.after.size(), on.after.size());
+  for (std::size_t k = 0; k < on.after.size(); ++k)
+  {
+    EXPECT_TRUE(on.after[k] == off.after[k]) << what << ": scan " << k << " differs with skip_unchanged";
+    EXPECT_EQ(off.skipped[k], 0.0) << what;
+  }
+  // Most of the window is unseen: once its cells reach their fixed point (some 25 scans after the prior comes), the
+  // step skips them until the window moves.
+  EXPECT_GT(*std::max_element(on.skipped.begin(), on.skipped.end()), 0.5) << what;
+  EXPECT_EQ(on.skipped[0], 0.0) << what << ": nothing is known to be stable before the first step";
+}
+
+}  // namespace
+
+TEST(SkipUnchanged, DefaultProfileGivesTheSameBytesAfterEveryScan)
+{
+  expectSameDrives(defaultProfile().map_grid, PriorKind::kAlways, "default, prior");
+  expectSameDrives(defaultProfile().map_grid, PriorKind::kNone, "default, no prior");
+  expectSameDrives(defaultProfile().map_grid, PriorKind::kFromScan20, "default, prior from scan 20");
+}
+
+TEST(SkipUnchanged, PaperProfileGivesTheSameBytesAfterEveryScan)
+{
+  expectSameDrives(paperProfile().map_grid, PriorKind::kAlways, "paper, prior");
+  expectSameDrives(paperProfile().map_grid, PriorKind::kNone, "paper, no prior");
+}
+
+TEST(SkipUnchanged, NothingIsSkippedWithRatesPerSecond)
+{
+  MapGridParams p = defaultProfile().map_grid;
+  p.rates_per_second = true;
+  const Drive on = drive(p, true, PriorKind::kAlways), off = drive(p, false, PriorKind::kAlways);
+  for (std::size_t k = 0; k < on.after.size(); ++k)
+  {
+    EXPECT_EQ(on.skipped[k], 0.0);
+    EXPECT_TRUE(on.after[k] == off.after[k]) << k;
+  }
+}
+
+TEST(SkipUnchanged, TheSkippedShareCountsWholeBlocksOfUnseenCells)
+{
+  const Drive on = drive(defaultProfile().map_grid, true, PriorKind::kNone);
+  const double seen = 3.14159 * kSeenRadius * kSeenRadius / (kWindow * kWindow);
+  for (std::size_t k = 0; k < on.skipped.size(); ++k)
+  {
+    EXPECT_GE(on.skipped[k], 0.0);
+    EXPECT_LE(on.skipped[k], 1.0 - seen + 0.01) << "a cell the scan sees is never skipped (scan " << k << ")";
+  }
+}
