@@ -114,7 +114,7 @@ TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
   MapGrid mg(params);
   ASSERT_EQ(mg.geometry().width % 8 == 0, GetParam() == 20.0);
   std::mt19937 rng(3);
-  auto& grid = mg.masses();
+  auto& grid = mg.mutableMasses();
   for (std::size_t i = 0; i < grid.numCells(); ++i)
   {
     grid.setCell(i, maf_test::randomMass<FrameMG>(rng, 6, false, true));

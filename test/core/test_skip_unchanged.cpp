@@ -1,7 +1,7 @@
 // MapGridParams::skip_unchanged: a drive with the skip and the same drive without it give the same bytes after every
 // scan (masses, ζ, BetP, map doubt, decisions, conflict sums), for the default and the paper profiles, with and
 // without a prior, across recentring, a prior that arrives late, tracked motion written between scans and masses
-// changed through masses(); and the skip does skip (most of the window once the unseen cells reach their fixed
+// changed through mutableMasses(); and the skip does skip (most of the window once the unseen cells reach their fixed
 // point), nothing with alpha_per_second or when it is off.
 #include <gtest/gtest.h>
 
@@ -68,7 +68,7 @@ struct Drive
 
 /// A drive whose scans see a disc around the vehicle (free, with a few occupied cells that move), the vehicle
 /// driving, stopping, then driving again (so that the window recentres), tracked motion written on unseen cells and
-/// one write through masses().
+/// one write through mutableMasses().
 Drive drive(MapGridParams params, bool skip, PriorKind prior_kind)
 {
   params.size_x = params.size_y = kWindow;
@@ -104,14 +104,14 @@ Drive drive(MapGridParams params, bool skip, PriorKind prior_kind)
     const FusionStepStats s = grid.update(scan, pose, 0.1 * step, with_prior ? &prior : nullptr);
     if (step == 30)
     {
-      // Tracked motion on cells far from the vehicle (stable by now), then a write through masses().
+      // Tracked motion on cells far from the vehicle (stable by now), then a write through mutableMasses().
       std::vector<CellMotion> cells;
       for (std::size_t i = 0; i < 200; ++i)
         cells.push_back(CellMotion{ i * 37 % grid.masses().numCells(), i % 3 ? CellClass::kMoving : CellClass::kStopped,
                                     0.5f });
       grid.applyTrackedMotion(cells);
     }
-    if (step == 40) grid.masses().setCell(5, MassMG{ { FrameMG::kC, 0.5 }, { FrameMG::kOmega, 0.5 } });
+    if (step == 40) grid.mutableMasses().setCell(5, MassMG{ { FrameMG::kC, 0.5 }, { FrameMG::kOmega, 0.5 } });
     d.after.push_back(snapshot(grid, s));
     d.skipped.push_back(grid.skippedShare());
   }

@@ -317,7 +317,8 @@ public:
 
   const MapMassGrid& masses() const { return grid_; }
   /// The masses to change in place: the next update() computes every cell again (MapGridParams::skip_unchanged).
-  MapMassGrid& masses()
+  /// (A separate name, so that reading masses() never costs the next update its skipped cells.)
+  MapMassGrid& mutableMasses()
   {
     forgetStable();
     return grid_;
