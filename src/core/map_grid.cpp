@@ -837,7 +837,6 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
   {
     if (c.cell >= n) continue;
     changed.push_back(c.cell);
-    if (!stable_.empty()) stable_[c.cell / MapMassGrid::kBlockCells] = 0;
     if (c.motion != CellClass::kMoving && c.motion != CellClass::kStopped) continue;
     const float beta = std::clamp(c.weight, 0.0f, 1.0f);
     if (!(beta > 0.0f)) continue;
@@ -864,6 +863,7 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
     kernels::pignistic(mass, p);
     for (int e = 0; e < FrameMG::kSize; ++e) betp_.p[e][c.cell] = p[e];
   }
+  forgetStable(changed);
   redecide(grid_, betp_, params_, changed, decision_);
   const auto stopped = static_cast<std::int8_t>(CellClass::kStopped), moving = static_cast<std::int8_t>(CellClass::kMoving);
   for (const CellMotion& c : cells)
