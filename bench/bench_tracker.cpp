@@ -1,5 +1,6 @@
 // The tracker's cost per scan (core/tracker.hpp), one thread: association and filtering of 200 measurements against
-// 200 established tracks, and the clustering of the scan's obstacle returns into those measurements.
+// 200 established tracks, the clustering of the scan's obstacle returns into those measurements, and a whole scan
+// (clustering, tracking and the free-space check on a 100 m ScanGrid).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -67,7 +68,56 @@ void BM_ClusterReturns(benchmark::State& state)
   state.counters["returns"] = static_cast<double>(points.size());
 }
 
+/// Scan @p k of BM_TrackerScan: @p n objects of 4 × 1.8 m, 100 returns each (vehicle frame = map frame), and a
+/// 100 m ScanGrid at 0.5 m, free but where the returns are.
+void scanScene(int n, int k, std::mt19937& rng, std::vector<float>& xy, ScanMassGrid& grid)
+{
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  xy.clear();
+  for (int i = 0; i < n; ++i)
+  {
+    const double speed = 1.0 + 9.0 * (i % 10) / 9.0;
+    const double cx = -45.0 + 4.5 * (i % 20) + speed * kScanPeriod * (k % 10), cy = -45.0 + 9.0 * (i / 20);
+    for (int p = 0; p < 100; ++p)
+    {
+      xy.push_back(static_cast<float>(cx + 4.0 * u(rng)));
+      xy.push_back(static_cast<float>(cy + 1.8 * u(rng)));
+    }
+  }
+  grid = ScanMassGrid(GridGeometry::centred(100.0, 100.0, 0.5));
+  const GridGeometry& g = grid.geometry();
+  for (std::size_t c = 0; c < g.numCells(); ++c) grid.setCell(c, MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } });
+  for (std::size_t p = 0; p + 1 < xy.size(); p += 2)
+  {
+    CellIndex c;
+    if (g.worldToCell(Point2{ xy[p], xy[p + 1] }, c))
+      grid.setCell(g.index(c), MassSG{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } });
+  }
+}
+
+void BM_TrackerScan(benchmark::State& state)
+{
+  const int n = static_cast<int>(state.range(0));
+  std::mt19937 rng(3);
+  constexpr int kScenes = 10;
+  std::vector<std::vector<float>> xy(kScenes);
+  std::vector<ScanMassGrid> grids(kScenes);
+  for (int k = 0; k < kScenes; ++k) scanScene(n, k, rng, xy[k], grids[k]);
+  TrackerParams params;
+  params.free_space_check = state.range(1) != 0;
+  Tracker tracker(params);
+  int k = 0;
+  for (auto _ : state)
+  {
+    const std::vector<float>& r = xy[k % kScenes];
+    tracker.update(kScanPeriod * k, Pose2{}, ObstaclePoints{ r.data(), r.size() / 2 }, nullptr, &grids[k % kScenes]);
+    ++k;
+  }
+  state.counters["tracks"] = static_cast<double>(tracker.tracks().size());
+}
+
 }  // namespace
 
+BENCHMARK(BM_TrackerScan)->ArgNames({ "n", "free_space_check" })->Args({ 200, 0 })->Args({ 200, 1 })->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TrackerUpdate)->Arg(200)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ClusterReturns)->Arg(200)->Unit(benchmark::kMicrosecond);

@@ -39,9 +39,15 @@ const std::vector<AddedStep>& addedSteps()
     { "motion_margin", "S or V within motion_margin of each other is decided 'occupied, motion not yet known'",
       [](const Profile& p) { return p.map_grid.motion_margin > 0.0; },
       [](Profile& p) { p.map_grid.motion_margin = 0.0; } },
+    { "free_space_check", "a track is moving only once free space shows that it left a place or came into one",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.free_space_check; },
+      [](Profile& p) { p.tracker.free_space_check = false; } },
     { "track_evidence", "a moving track supports {V} in its cells, a stopped one {S}; one not yet known makes them neither",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_weight > 0.0; },
       [](Profile& p) { p.tracker.evidence_weight = 0.0; } },
+    { "track_box", "track evidence also in the cells of a track's box that hold none of its returns",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box; },
+      [](Profile& p) { p.tracker.evidence_box = false; } },
   };
   return steps;
 }

@@ -12,6 +12,41 @@ constexpr double kMinSigma = 1e-6;  // m/s
 
 double normalCdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
+/// Appends to @p out, as interior cells like @p c, the cells of @p g whose centre lies in the box of @p m and that are
+/// not among out[first, end) (sorted).
+void addBoxInterior(const Measurement& m, const GridGeometry& g, CellMotion c, std::size_t first,
+                    std::vector<CellMotion>& out)
+{
+  const double cu = std::cos(m.yaw), su = std::sin(m.yaw);
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (double u : { m.lo_u, m.hi_u })
+    for (double v : { m.lo_v, m.hi_v })
+    {
+      const double x = m.centroid.x + u * cu - v * su, y = m.centroid.y + u * su + v * cu;
+      x0 = std::min(x0, x);
+      y0 = std::min(y0, y);
+      x1 = std::max(x1, x);
+      y1 = std::max(y1, y);
+    }
+  if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) return;
+  const CellIndex a = g.cellAt(Point2{ x0, y0 }), b = g.cellAt(Point2{ x1, y1 });
+  const std::size_t end = out.size();
+  c.interior = true;
+  for (int cy = std::max(0, a.y); cy <= std::min(g.height - 1, b.y); ++cy)
+    for (int cx = std::max(0, a.x); cx <= std::min(g.width - 1, b.x); ++cx)
+    {
+      const Point2 q = g.cellCentre(CellIndex{ cx, cy });
+      const double dx = q.x - m.centroid.x, dy = q.y - m.centroid.y;
+      const double u = dx * cu + dy * su, v = -dx * su + dy * cu;
+      if (u < m.lo_u || u > m.hi_u || v < m.lo_v || v > m.hi_v) continue;
+      c.cell = g.index(CellIndex{ cx, cy });
+      const auto from = out.begin() + static_cast<std::ptrdiff_t>(first), to = out.begin() + static_cast<std::ptrdiff_t>(end);
+      if (std::binary_search(from, to, c, [](const CellMotion& l, const CellMotion& r) { return l.cell < r.cell; }))
+        continue;
+      out.push_back(c);
+    }
+}
+
 }  // namespace
 
 double motionProbability(const Track& t, const TrackerParams& p)
@@ -56,12 +91,14 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     out.erase(std::unique(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
                           [](const CellMotion& a, const CellMotion& b) { return a.cell == b.cell; }),
               out.end());
+    if (p.evidence_box && c.motion != CellClass::kOccupied)
+      addBoxInterior(measurements[t.measurement], g, c, first, out);
   }
   return out;
 }
 
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
-               std::vector<std::uint8_t>& background)
+               std::vector<std::uint8_t>& background, const ScanMassGrid* scan)
 {
   const GridGeometry& g = grid.geometry();
   const MapMassGrid& masses = grid.masses();
@@ -71,7 +108,7 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
                     return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
                   },
                   background);
-  tracker.update(stamp, pose, returns, &background);
+  tracker.update(stamp, pose, returns, &background, scan);
   grid.applyTrackedMotion(trackEvidence(tracker, g));
 }
 

@@ -21,6 +21,8 @@ constexpr double kTinySpeed = 1e-6;    // m/s: below, the speed's direction is u
 constexpr double kMinStep = 1e-6;      // s between two scans
 constexpr double kMaxDenseCells = 4e6;  // cells of the dense clustering grid (16 MB of indices) before a hash map
 constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
+constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
+constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
 
 std::int64_t cellKey(std::int64_t x, std::int64_t y) { return (x << 32) ^ (y & 0xffffffffLL); }
 
@@ -60,6 +62,9 @@ void TrackerParams::validate() const
   requirePositive("tracker_max_speed", max_speed);
   requirePositive("tracker_max_ego_speed", max_ego_speed);
   requireUnit("tracker_evidence_weight", evidence_weight);
+  requireInRange("tracker_free_space_share", free_space_share, kMinShare, 1.0);
+  requireInRange("tracker_free_space_margin", free_space_margin, 0.0, kMaxCellSize);
+  requireInRange("tracker_free_space_time", free_space_time, kMinStep, kMaxFreeSpaceTime);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -326,6 +331,11 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
     t.state = TrackState::kConfirmed;
 }
 
+bool Tracker::fastEnough(const Track& t) const
+{
+  return t.speed() - params_.motion_sigmas * t.speedSigma() > params_.moving_speed;
+}
+
 void Tracker::decideMotion(Track& t, double stamp) const
 {
   if (t.state == TrackState::kTentative)
@@ -340,7 +350,7 @@ void Tracker::decideMotion(Track& t, double stamp) const
   }
   else
     t.still_since = -1.0;
-  if (s - params_.motion_sigmas * sigma > params_.moving_speed)
+  if (fastEnough(t) && (!free_now_ || t.motion_seen))
     t.motion = TrackMotion::kMoving;
   else if (t.still_since >= 0.0 && stamp - t.still_since >= params_.stopped_time - kMinStep)
     t.motion = TrackMotion::kStopped;
@@ -348,8 +358,41 @@ void Tracker::decideMotion(Track& t, double stamp) const
     t.motion = TrackMotion::kUnknown;
 }
 
+void Tracker::seeFreeSpace(Track& t, double stamp)
+{
+  if (t.measurement < 0) return;
+  const std::vector<int>& idx = measurements_[t.measurement].returns;
+  Sighting now;
+  now.stamp = stamp;
+  const std::size_t n = std::min(idx.size(), static_cast<std::size_t>(kSightingPoints));
+  now.points.reserve(n);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    const int i = idx[k * idx.size() / n];
+    if (i >= 0 && i < static_cast<int>(map_points_.size())) now.points.push_back(map_points_[i]);
+  }
+  if (!t.motion_seen && fastEnough(t))
+  {
+    // It left: the returns of one earlier sighting lie in the free space of this scan.
+    const SeenFree& current = seen_free_.back();
+    for (const Sighting& past : t.sightings)
+      t.motion_seen = t.motion_seen || current.clearShare(past.points) >= params_.free_space_share;
+    // It came: its returns of this scan lie where some earlier scan saw free space.
+    std::size_t came = 0;
+    for (const Point2& q : now.points)
+      came += std::any_of(seen_free_.begin(), seen_free_.end() - 1, [&](const SeenFree& f) { return f.clear(q); });
+    t.motion_seen = t.motion_seen || (!now.points.empty() && static_cast<double>(came) >=
+                                                                 params_.free_space_share * static_cast<double>(now.points.size()));
+  }
+  const double oldest = stamp - params_.free_space_time - kMinStep;
+  t.sightings.erase(std::remove_if(t.sightings.begin(), t.sightings.end(),
+                                   [&](const Sighting& s) { return s.stamp < oldest || s.stamp >= stamp; }),
+                    t.sightings.end());
+  t.sightings.push_back(std::move(now));
+}
+
 void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& returns,
-                     const std::vector<std::uint8_t>* background)
+                     const std::vector<std::uint8_t>* background, const ScanMassGrid* scan)
 {
   if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw) || !std::isfinite(stamp))
   {
@@ -361,8 +404,20 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   {
     reset();
     ++counts_.resets;
+    seen_free_.clear();
   }
   last_pose_ = pose;
+  free_now_ = scan && params_.free_space_check;
+  if (free_now_)
+  {
+    const double oldest = stamp - params_.free_space_time - kMinStep;
+    seen_free_.erase(std::remove_if(seen_free_.begin(), seen_free_.end(),
+                                    [&](const SeenFree& f) { return f.stamp() < oldest || f.stamp() >= stamp; }),
+                     seen_free_.end());
+    seen_free_.emplace_back(*scan, pose, stamp, params_.free_space_margin);
+  }
+  else
+    seen_free_.clear();
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   map_points_.clear();
   map_points_.reserve(returns.count);
@@ -392,7 +447,11 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
 void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
 {
   ++counts_.scans;
-  if (&measurements != &own_measurements_) map_points_.clear();
+  if (&measurements != &own_measurements_)
+  {
+    map_points_.clear();
+    free_now_ = false;
+  }
   if (!std::isfinite(stamp))
   {
     ++counts_.non_finite_inputs;
@@ -484,8 +543,9 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       ++counts_.tracks_deleted;
       continue;
     }
+    if (free_now_) seeFreeSpace(t, stamp);
     decideMotion(t, stamp);
-    kept.push_back(t);
+    kept.push_back(std::move(t));
   }
   const double v2 = params_.initial_speed_sigma * params_.initial_speed_sigma;
   for (std::size_t m = 0; m < measurements_.size(); ++m)
@@ -508,8 +568,9 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     t.first_stamp = t.last_hit = stamp;
     t.measurement = static_cast<int>(m);
     if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
+    if (free_now_) seeFreeSpace(t, stamp);
     decideMotion(t, stamp);
-    kept.push_back(t);
+    kept.push_back(std::move(t));
     ++counts_.tracks_created;
   }
   tracks_ = std::move(kept);

@@ -400,5 +400,52 @@ TEST(MotionSteps, TrackEvidenceMovesTheDynamicMassesToTheTrackedMotion)
   EXPECT_EQ(massesOf(run.grid, i), kept);
 }
 
+TEST(MotionSteps, TrackBoxInteriorCellsGiveOnlyFromTheSetsThatHoldTheClass)
+{
+  World world;
+  world.boxes.push_back({ 10.0, -1.0, 14.0, 1.0, 1.5 });
+  core::Run run(defaultProfile());
+  const GridGeometry& g = run.grid.geometry();
+  PriorWindow road;
+  road.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
+  std::fill(road.road.begin(), road.road.end(), 0.85f);
+  for (int k = 0; k < 4; ++k) run.step(world, Pose2{ 0.0, 0.0, 0.0 }, &road);
+  // A cell seen free in front of the car (mass on {F}) and a hidden one behind its near side (mass on {F, S, V}).
+  CellIndex ci;
+  ASSERT_TRUE(g.worldToCell(Point2{ 8.1, 0.1 }, ci));
+  const std::size_t seen = g.index(ci);
+  ASSERT_TRUE(g.worldToCell(Point2{ 12.1, 0.1 }, ci));
+  const std::size_t hidden = g.index(ci);
+  for (std::size_t c : { seen, hidden })
+  {
+    const std::vector<float> before = massesOf(run.grid, c);
+    double moved = 0.0;
+    for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+      if (a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0)
+        moved += 0.5 * before[a];
+    run.grid.applyTrackedMotion({ CellMotion{ c, CellClass::kMoving, 0.5f, true } });
+    const std::vector<float> after = massesOf(run.grid, c);
+    double total = 0.0;
+    for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+    {
+      EXPECT_GE(after[a], 0.0f);
+      total += after[a];
+      const bool gives = a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0;
+      if (a == FrameMG::kV)
+        EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
+      else
+        EXPECT_NEAR(after[a], gives ? 0.5 * before[a] : before[a], 1e-6) << subsetName<FrameMG>(a);
+    }
+    EXPECT_NEAR(total, 1.0, 1e-5);
+    if (c == seen)
+    {
+      EXPECT_GT(before[FrameMG::kF], 0.5f) << "seen free";
+      EXPECT_EQ(after[FrameMG::kF], before[FrameMG::kF]) << "free space stays free";
+    }
+    else
+      EXPECT_GT(moved, 0.1) << "the hidden cell's {F, S, V} gives to V";
+  }
+}
+
 }  // namespace core
 }  // namespace map_aided_fusion

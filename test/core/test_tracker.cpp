@@ -324,18 +324,182 @@ TEST(Tracker, EvidenceCoversTheCellsOfTheLastClusterWithTheMotionProbability)
     ASSERT_TRUE(g.worldToCell(Point2{ xy[i], xy[i + 1] }, c));
     expected.insert(g.index(c));
   }
-  std::set<std::size_t> got;
+  // Step track box: the cells whose centre lies in the cluster's box (16.4 ± 2 m by 5 ± 1 m) and hold no return.
+  std::set<std::size_t> expected_interior;
+  for (int cy = 0; cy < g.height; ++cy)
+    for (int cx = 0; cx < g.width; ++cx)
+    {
+      const Point2 q = g.cellCentre(CellIndex{ cx, cy });
+      if (std::abs(q.x - 16.4) <= 2.0 && std::abs(q.y - 5.0) <= 1.0 && !expected.count(g.index(CellIndex{ cx, cy })))
+        expected_interior.insert(g.index(CellIndex{ cx, cy }));
+    }
+  ASSERT_FALSE(expected_interior.empty());
+  std::set<std::size_t> got, got_interior;
   for (const CellMotion& c : cells)
   {
-    got.insert(c.cell);
+    (c.interior ? got_interior : got).insert(c.cell);
     EXPECT_EQ(c.motion, CellClass::kMoving);
     EXPECT_NEAR(c.weight, 0.8 * p, 1e-6);
   }
   EXPECT_EQ(got, expected);
-  EXPECT_EQ(got.size(), cells.size()) << "one entry per cell";
+  EXPECT_EQ(got_interior, expected_interior);
+  EXPECT_EQ(got.size() + got_interior.size(), cells.size()) << "one entry per cell";
+  TrackerParams no_box;
+  no_box.evidence_box = false;
+  Tracker returns_only(no_box);
+  for (int k = 0; k <= 8; ++k)
+  {
+    std::vector<float> car;
+    for (const Point2& q : boxOutline(10.0 + 0.8 * k, 5.0, 0.0, 4.0, 2.0))
+    {
+      car.push_back(static_cast<float>(q.x));
+      car.push_back(static_cast<float>(q.y));
+    }
+    returns_only.update(0.1 * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ car.data(), car.size() / 2 });
+  }
+  EXPECT_EQ(trackEvidence(returns_only, g).size(), expected.size());
   TrackerParams off;
   off.evidence_weight = 0.0;
   Tracker silent(off);
   silent.update(0.0, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
   EXPECT_TRUE(trackEvidence(silent, g).empty());
+}
+
+namespace {
+
+/// A ScanGrid of 60 × 60 m at 0.5 m centred on the vehicle: m(F) = 0.7 where @p free(vehicle-frame cell centre),
+/// m(O) = 0.8 in the cells holding @p returns (vehicle frame), vacuous elsewhere.
+template <class Free>
+ScanMassGrid scanGrid(const std::vector<float>& returns, Free&& free)
+{
+  ScanMassGrid grid(GridGeometry::centred(60.0, 60.0, 0.5));
+  const GridGeometry& g = grid.geometry();
+  for (std::size_t i = 0; i < g.numCells(); ++i)
+    grid.setCell(i, free(g.cellCentre(g.cellOf(i))) ? MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } }
+                                                      : MassSG{ { FrameSG::kOmega, 1.0 } });
+  for (std::size_t k = 0; k + 1 < returns.size(); k += 2)
+  {
+    CellIndex c;
+    if (g.worldToCell(Point2{ returns[k], returns[k + 1] }, c))
+      grid.setCell(g.index(c), MassSG{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } });
+  }
+  return grid;
+}
+
+std::vector<float> flatten(const std::vector<Point2>& points)
+{
+  std::vector<float> xy;
+  for (const Point2& p : points)
+  {
+    xy.push_back(static_cast<float>(p.x));
+    xy.push_back(static_cast<float>(p.y));
+  }
+  return xy;
+}
+
+}  // namespace
+
+TEST(SeenFree, ClearMeansEveryCellWithinTheMarginWasSeenFree)
+{
+  // Free everywhere but one occupied cell at vehicle (2.25, 0.25) and the vacuous half-plane y >= 10.
+  const std::vector<float> occupied{ 2.3f, 0.2f };
+  const ScanMassGrid scan = scanGrid(occupied, [](Point2 p) { return p.y < 10.0; });
+  const Pose2 pose{ 10.0, 0.0, M_PI / 2 };  // vehicle (x, y) is map (10 − y, x)
+  auto map = [&](double x, double y) { return Point2{ 10.0 - y, x }; };
+  const SeenFree one_cell(scan, pose, 3.0, 0.5);
+  EXPECT_DOUBLE_EQ(one_cell.stamp(), 3.0);
+  EXPECT_FALSE(one_cell.clear(map(2.25, 0.25))) << "the occupied cell";
+  EXPECT_FALSE(one_cell.clear(map(2.75, 0.25))) << "next to it";
+  EXPECT_FALSE(one_cell.clear(map(1.75, -0.25))) << "diagonally next to it";
+  EXPECT_TRUE(one_cell.clear(map(3.25, 0.25)));
+  EXPECT_TRUE(one_cell.clear(map(-3.0, 9.25)));
+  EXPECT_FALSE(one_cell.clear(map(-3.0, 9.75))) << "next to space not seen";
+  EXPECT_FALSE(one_cell.clear(map(-3.0, 12.0))) << "not seen";
+  EXPECT_FALSE(one_cell.clear(map(40.0, 0.0))) << "outside the grid";
+  EXPECT_FALSE(one_cell.clear(Point2{ std::nan(""), 0.0 }));
+  EXPECT_DOUBLE_EQ(one_cell.clearShare({ map(2.25, 0.25), map(3.25, 0.25), map(5.0, 5.0), map(0.0, 20.0) }), 0.5);
+  EXPECT_DOUBLE_EQ(one_cell.clearShare({}), 0.0);
+  // Margin 0: the cell itself; 0.6 m rounds up to two cells.
+  const SeenFree own_cell(scan, pose, 3.0, 0.0);
+  EXPECT_FALSE(own_cell.clear(map(2.25, 0.25)));
+  EXPECT_TRUE(own_cell.clear(map(2.75, 0.25)));
+  EXPECT_TRUE(own_cell.clear(map(-3.0, 9.75)));
+  const SeenFree two_cells(scan, pose, 3.0, 0.6);
+  EXPECT_FALSE(two_cells.clear(map(3.25, 0.25)));
+  EXPECT_TRUE(two_cells.clear(map(3.75, 0.25)));
+  // Clear cells: 120 × 120 minus the 40 rows from y = 10 on, the margin's row before them, and the 3 × 3 block.
+  EXPECT_EQ(one_cell.clearCells(), 120u * 120u - 40u * 120u - 120u - 9u);
+}
+
+TEST(Tracker, FreeSpaceCheckTellsAMoverFromAWallFragmentThatSlidesAlong)
+{
+  // Vehicle frame = map frame. A 4 × 2 m car at 5 m/s along y = 5 over free road; a 1 m piece of a wall along y = 15
+  // (all that is seen of it) whose visible part slides at 5 m/s as if the view changed, space behind the wall not seen.
+  auto run = [](bool check, std::uint32_t& car_moving_from, bool& wall_moving) {
+    TrackerParams p;
+    p.free_space_check = check;
+    Tracker tracker(p);
+    car_moving_from = 0;
+    wall_moving = false;
+    for (int k = 0; k <= 15; ++k)
+    {
+      std::vector<Point2> car = boxOutline(-10.0 + 0.5 * k, 5.0, 0.0, 4.0, 2.0);
+      std::vector<Point2> wall;
+      for (int j = 0; j <= 20; ++j) wall.push_back(Point2{ -10.0 + 0.5 * k + 0.05 * j, 15.1 });
+      for (int j = 0; j <= 20; ++j) wall.push_back(Point2{ -10.0 + 0.5 * k + 0.05 * j, 15.2 });
+      std::vector<float> xy = flatten(car);
+      const std::vector<float> w = flatten(wall);
+      xy.insert(xy.end(), w.begin(), w.end());
+      // The car hides nothing the test looks at; the road is seen free up to the wall.
+      const ScanMassGrid scan = scanGrid(xy, [](Point2 q) { return q.y < 15.0; });
+      tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, &scan);
+      for (const Track& t : tracker.tracks())
+      {
+        if (t.motion != TrackMotion::kMoving) continue;
+        if (t.x(1) > 10.0)
+          wall_moving = true;
+        else if (!car_moving_from)
+          car_moving_from = static_cast<std::uint32_t>(k);
+      }
+    }
+    return tracker.counts().tracks_created;
+  };
+  std::uint32_t car_from = 0;
+  bool wall = false;
+  EXPECT_EQ(run(true, car_from, wall), 2u);
+  EXPECT_FALSE(wall) << "a sliding view of a wall is not a mover";
+  EXPECT_GE(car_from, 3u);
+  EXPECT_LE(car_from, 6u) << "the car is moving within half a second";
+  std::uint32_t car_without = 0;
+  EXPECT_EQ(run(false, car_without, wall), 2u);
+  EXPECT_TRUE(wall) << "without the check, the velocity alone calls the wall fragment moving";
+  EXPECT_LE(car_without, car_from);
+  // Without a ScanGrid (update(stamp, measurements) or no scan given), the motion comes from the velocity alone.
+  Tracker no_scan;
+  for (int k = 0; k <= 8; ++k) no_scan.update(0.1 * k, { at(8.0 * 0.1 * k, 0.0) });
+  ASSERT_EQ(no_scan.tracks().size(), 1u);
+  EXPECT_EQ(no_scan.tracks()[0].motion, TrackMotion::kMoving);
+}
+
+TEST(Tracker, FreeSpaceParametersAreValidatedByName)
+{
+  for (auto [name, set] : std::vector<std::pair<std::string, void (*)(TrackerParams&)>>{
+           { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
+           { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
+           { "tracker_free_space_margin", [](TrackerParams& p) { p.free_space_margin = -0.1; } },
+           { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = 0.0; } },
+           { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } } })
+  {
+    TrackerParams p;
+    set(p);
+    try
+    {
+      p.validate();
+      ADD_FAILURE() << name << " accepted";
+    }
+    catch (const ParameterError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
 }

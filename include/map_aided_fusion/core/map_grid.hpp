@@ -181,6 +181,9 @@ struct CellMotion
   std::size_t cell = 0;
   CellClass motion = CellClass::kMoving;  ///< kMoving, kStopped, or kOccupied (occupied, motion not yet known)
   float weight = 0.0f;                    ///< β in [0, 1] (kMoving, kStopped)
+  /// A cell of the object's box holding none of its returns (seen over, or hidden behind, its near side): only sets
+  /// that hold the target class move, so that space seen free stays free.
+  bool interior = false;
 };
 
 /// An object made of a connected region of moving or stopped cells.

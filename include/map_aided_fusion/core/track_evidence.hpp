@@ -31,11 +31,12 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
 
 /**
  * @brief One scan of tracking after @p grid's update(): flags the returns on static background (the grid's counter ζ
- *        above background_zeta, backgroundFlags()), updates @p tracker, and applies its evidence to @p grid
+ *        above background_zeta, backgroundFlags()), updates @p tracker with the scan's ScanGrid @p scan (vehicle
+ *        frame; the free space of step free-space check, nullptr: none), and applies its evidence to @p grid
  *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan.
  */
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
-               std::vector<std::uint8_t>& background);
+               std::vector<std::uint8_t>& background, const ScanMassGrid* scan = nullptr);
 
 }  // namespace core
 }  // namespace map_aided_fusion

@@ -12,12 +12,15 @@
 
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
+#include "map_aided_fusion/core/mass_grid.hpp"
+#include "map_aided_fusion/core/seen_free.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -50,9 +53,20 @@ struct TrackerParams
   double stopped_time = 1.0;         ///< s … for this long
   double max_speed = 50.0;           ///< m/s: a track estimated faster is deleted (a wrong association)
   double max_ego_speed = 70.0;       ///< m/s: a vehicle pose moving faster between two scans resets every track
+  /// Step "free-space check": a track is moving only once free space shows the motion, i.e. this share of its returns
+  /// of an earlier scan lies where the last scan saw free space (it left), or of its returns of the last scan where an
+  /// earlier scan saw free space (it came). A velocity alone does not tell an object from a fragment of a wall or a
+  /// hedge whose visible part slides as the vehicle drives by.
+  bool free_space_check = true;
+  double free_space_share = 0.3;     ///< share of a sighting's returns that must lie in free space, (0, 1]
+  double free_space_margin = 0.5;    ///< m: a point is in free space when every ScanGrid cell this near was seen free
+  double free_space_time = 1.0;      ///< s: how far back sightings and scans are compared
   /// Step "track evidence" (core/track_evidence.hpp): the weight w of a track's motion in its cells' masses,
   /// β = w · P(motion); 0: off.
   double evidence_weight = 0.8;
+  /// … given also to the cells of its measurement's box that hold none of its returns (seen over or hidden behind
+  /// the object's near side), from the sets that already hold the track's class only.
+  bool evidence_box = true;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -83,7 +97,12 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_stopped_time", p.stopped_time, { "s", "see tracker_stopped_speed" });
   get("tracker_max_speed", p.max_speed, { "m/s", "a track estimated faster is deleted (a wrong association)" });
   get("tracker_max_ego_speed", p.max_ego_speed, { "m/s", "a vehicle pose moving faster between two scans resets every track" });
+  get("tracker_free_space_check", p.free_space_check, { "", "step free-space check: moving only once free space shows that the track left a place or came into one" });
+  get("tracker_free_space_share", p.free_space_share, { "", "share of a sighting's returns that must lie in free space" });
+  get("tracker_free_space_margin", p.free_space_margin, { "m", "a point is in free space when every ScanGrid cell this near (whole cells) was seen free" });
+  get("tracker_free_space_time", p.free_space_time, { "s", "how far back the free-space check compares sightings and scans" });
   get("tracker_evidence_weight", p.evidence_weight, { "", "step track evidence: weight w of a track's motion in its cells (β = w·P(motion)); 0: off" });
+  get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
 }
 
 /**
@@ -140,8 +159,15 @@ enum class TrackState : std::uint8_t
 enum class TrackMotion : std::uint8_t
 {
   kUnknown,
-  kMoving,
-  kStopped,
+  kMoving,   ///< speed − motion_sigmas · σ above moving_speed (and, with the free-space check, Track::motion_seen)
+  kStopped,  ///< speed + motion_sigmas · σ below stopped_speed for stopped_time
+};
+
+/// Where a track's returns were in one scan (at most Tracker::kSightingPoints of them, map frame).
+struct Sighting
+{
+  double stamp = 0.0;
+  std::vector<Point2> points;
 };
 
 /// A tracked object. State x = (x, y, vx, vy) in the map frame, covariance P.
@@ -161,6 +187,9 @@ struct Track
   double first_stamp = 0.0;
   double last_hit = 0.0;                        ///< stamp of the last association
   double still_since = -1.0;                    ///< stamp since which it is confidently slow (−1: not)
+  /// Step free-space check: free space showed that it moved (it stays so); its sightings of the last free_space_time.
+  bool motion_seen = false;
+  std::vector<Sighting> sightings;
 
   Point2 position() const { return Point2{ x(0), x(1) }; }
   Point2 velocity() const { return Point2{ x(2), x(3) }; }
@@ -202,13 +231,18 @@ public:
   /**
    * @brief One scan: @p returns in the vehicle frame (ScanGridBuilder::obstaclePoints()), the vehicle pose @p pose
    *        in the map frame at @p stamp (s); @p background, when given, flags each return on static background
-   *        (backgroundFlags()). A stamp not after the last one, or a pose moving faster than max_ego_speed, resets
+   *        (backgroundFlags()); @p scan, when given, is the scan's ScanGrid (vehicle frame), the free space of the
+   *        step free-space check. A stamp not after the last one, or a pose moving faster than max_ego_speed, resets
    *        every track first (counted).
    */
   void update(double stamp, const Pose2& pose, const ObstaclePoints& returns,
-              const std::vector<std::uint8_t>* background = nullptr);
-  /// One scan's measurements (map frame), for tests and for callers that cluster themselves.
+              const std::vector<std::uint8_t>* background = nullptr, const ScanMassGrid* scan = nullptr);
+  /// One scan's measurements (map frame), for tests and for callers that cluster themselves (no free-space check:
+  /// the motion is decided from the velocity alone).
   void update(double stamp, const std::vector<Measurement>& measurements);
+
+  /// Returns of a measurement a sighting keeps (evenly chosen).
+  static constexpr int kSightingPoints = 32;
 
   const std::vector<Track>& tracks() const { return tracks_; }
   const std::vector<Measurement>& measurements() const { return measurements_; }
@@ -223,6 +257,9 @@ private:
   void predict(Track& t, double dt) const;
   void correct(Track& t, const Measurement& m, double stamp) const;
   void decideMotion(Track& t, double stamp) const;
+  /// Step free-space check: records @p t's sighting of this scan and tells whether free space shows its motion.
+  void seeFreeSpace(Track& t, double stamp);
+  bool fastEnough(const Track& t) const;
 
   TrackerParams params_;
   std::vector<Track> tracks_;
@@ -230,6 +267,8 @@ private:
   std::vector<Measurement> own_measurements_;  ///< the last scan's clusters (update(stamp, pose, returns))
   std::vector<Point2> map_points_;
   std::vector<std::uint8_t> map_flags_;
+  std::deque<SeenFree> seen_free_;  ///< the free space of the scans of the last free_space_time, oldest first
+  bool free_now_ = false;           ///< seen_free_ holds this scan's (the check runs)
   TrackerCounts counts_;
   std::uint32_t next_id_ = 1;
   double last_stamp_ = -1.0;
