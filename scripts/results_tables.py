@@ -98,13 +98,13 @@ def summary(sim, kitti, tracking):
             lines.append(f"| {data} | {title} | {f(variants['default'])} | {f(variants['paper'])} |")
 
     cols = dict(SIM_COLUMNS)
-    for title in ("IoU F", "IoU C", "V precision", "V recall", "movers V ≤ 1 s", "V trail (cells/scan)"):
+    for title in ("IoU F", "IoU C", "V precision", "V recall", "movers V ≤ 1 s", "V trail (cells/scan)", "MOTA"):
         add("simulator", sim, title, cols[title])
     cols = dict(KITTI_COLUMNS)
     for title in ("false V / labelled sweep", "motorcyclist V share from its 3rd sweep"):
         add("KITTI 00", kitti, title, cols[title])
     cols = dict(TRACKING_COLUMNS)
-    for title in ("movers V ≤ 1 s", "movers' mean V share", "movers' cells S", "false V / scan"):
+    for title in ("movers V ≤ 1 s", "movers' mean V share", "movers' cells S", "false V / scan", "MOTA"):
         add("KITTI tracking", tracking, title, cols[title])
     return "\n".join(lines) + "\n"
 

@@ -40,7 +40,7 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     write_metrics(str(out / "kitti" / "metrics.json"),
                   {"default": {"false_v_per_labelled_sweep": 2.5}, "paper": {"false_v_per_labelled_sweep": 140}})
     write_metrics(str(out / "kitti_tracking" / "metrics.json"),
-                  {"default": {"movers.all.detected_within_1s": 3, "movers.all.seen": 5},
+                  {"default": {"movers.all.detected_within_1s": 3, "movers.all.seen": 5, "tracks.mota": 0.853},
                    "paper": {"movers.all.detected_within_1s": 1, "movers.all.seen": 5}})
     (tmp_path / "doc").mkdir()
     readme = fake_readme(str(tmp_path))
@@ -52,6 +52,7 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     assert "| simulator | movers V ≤ 1 s | 4/11 | 7/11 |" in text
     assert "| KITTI 00 | false V / labelled sweep | 2.5 | 140.0 |" in text
     assert "| KITTI tracking | movers V ≤ 1 s | 3/5 | 1/5 |" in text
+    assert "| KITTI tracking | MOTA | 0.85 | – |" in text, "the paper has no tracks"
     assert "old table" not in text and text.endswith("after\n")
     doc = open(tmp_path / "doc" / "results.md").read()
     assert "## KITTI 00" in doc and "| default | 0.875 |" in doc
