@@ -842,18 +842,16 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
     if (!(beta > 0.0f)) continue;
     const unsigned target = c.motion == CellClass::kMoving ? FrameMG::kV : FrameMG::kS;
     const unsigned other = c.motion == CellClass::kMoving ? FrameMG::kS : FrameMG::kV;
-    // A moving track takes V from every set that holds V (free space showed that it moved: it is no pole); a stopped
-    // one cannot tell a parked car from a pole, so the static classes stay the prior's and the counter's for it.
+    // Only sets within {F, S, V}: the static classes stay the prior's and the counter's (a false moving track on a
+    // pole must not take its N).
     const unsigned dynamic = FrameMG::kF | FrameMG::kS | FrameMG::kV;
-    const unsigned holding = c.motion == CellClass::kMoving ? ~0u : dynamic;  // sets with the target that give
     const unsigned agreeing = c.interior ? 0u : FrameMG::kF | other;  // sets within {F, other} go to the target
     float mass[kernels::kSubsets];
     kernels::loadMasses(base, c.cell, mass);
     float to_target = 0.0f;
     for (unsigned a = 1; a < static_cast<unsigned>(kernels::kSubsets); ++a)
     {
-      const bool gives = (a & target) ? (a & ~holding) == 0 : (a & ~agreeing) == 0;
-      if (a == target || mass[a] == 0.0f || !gives) continue;
+      if (a == target || mass[a] == 0.0f || (a & ~dynamic) != 0 || !((a & target) || (a & ~agreeing) == 0)) continue;
       const float moved = beta * mass[a];
       mass[a] -= moved;
       to_target += moved;

@@ -358,8 +358,8 @@ void seeCarOnRoad(Run& run)
 
 }  // namespace
 
-// Step "track evidence": the transfer to {V} of β·m(A), by its definition, on the cell of a car seen for a few scans on
-// a road; still a mass function; decisions again.
+// Step "track evidence": the transfer to {V} of β·m(A) for every A ⊆ {F, S, V}, by its definition, on the cell of a
+// car seen for a few scans on a road; the sets holding C or N untouched; still a mass function; decisions again.
 TEST(MotionSteps, TrackEvidenceMovesTheDynamicMassesToTheTrackedMotion)
 {
   core::Run run(defaultProfile());  // qualified: Run alone is gtest's Test::Run
@@ -371,8 +371,10 @@ TEST(MotionSteps, TrackEvidenceMovesTheDynamicMassesToTheTrackedMotion)
   ASSERT_TRUE(g.worldToCell(Point2{ 30.0, 20.0 }, ci));
   const std::size_t far = g.index(ci);
   const std::vector<float> before = massesOf(run.grid, i), far_before = massesOf(run.grid, far);
-  // Moving: every set that holds V, and the sets within {F, S}.
-  auto gives = [](Subset a) { return a != FrameMG::kV && ((a & FrameMG::kV) || (a & ~(FrameMG::kF | FrameMG::kS)) == 0); };
+  // Moving: the sets within {F, S, V} that hold V or lie within {F, S}.
+  auto gives = [](Subset a) {
+    return a != FrameMG::kV && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0;
+  };
   double moved = 0.0;
   for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
     if (gives(a)) moved += 0.5 * before[a];
@@ -389,7 +391,7 @@ TEST(MotionSteps, TrackEvidenceMovesTheDynamicMassesToTheTrackedMotion)
     else if (gives(a))
       EXPECT_NEAR(after[a], 0.5 * before[a], 1e-6) << subsetName<FrameMG>(a);
     else
-      EXPECT_NEAR(after[a], before[a], 1e-6) << subsetName<FrameMG>(a) << " holds neither V nor only F, S: untouched";
+      EXPECT_NEAR(after[a], before[a], 1e-6) << subsetName<FrameMG>(a) << " holds C or N: untouched";
   }
   EXPECT_NEAR(total, 1.0, 1e-5);
   EXPECT_EQ(massesOf(run.grid, far), far_before);
@@ -405,8 +407,9 @@ TEST(MotionSteps, TrackEvidenceMovesTheDynamicMassesToTheTrackedMotion)
   EXPECT_EQ(massesOf(run.grid, i), kept);
 }
 
-// Without a prior the car's cells hold {C, N, S, V}: a moving track takes V from it, a stopped one leaves it.
-TEST(MotionSteps, TrackEvidenceOfAMovingTrackReachesSetsHoldingStaticClassesAndOfAStoppedOneDoesNot)
+// Without a prior the car's cells hold {C, N, S, V}: neither a moving nor a stopped track takes from it (measured: moving
+// tracks on static objects that free space confirmed then turned them V on KITTI 00).
+TEST(MotionSteps, TrackEvidenceLeavesSetsHoldingStaticClassesAlone)
 {
   World world;
   world.boxes.push_back({ 10.0, -1.0, 14.0, 1.0, 1.5 });
@@ -426,8 +429,8 @@ TEST(MotionSteps, TrackEvidenceOfAMovingTrackReachesSetsHoldingStaticClassesAndO
   moving.grid.applyTrackedMotion({ CellMotion{ i, CellClass::kMoving, 0.5f } });
   stopped.grid.applyTrackedMotion({ CellMotion{ i, CellClass::kStopped, 0.5f } });
   const std::vector<float> m = massesOf(moving.grid, i), s = massesOf(stopped.grid, i);
-  EXPECT_NEAR(m[occupied], 0.5 * before[occupied], 1e-6);
-  EXPECT_NEAR(s[occupied], before[occupied], 1e-6);
+  EXPECT_EQ(m[occupied], before[occupied]);
+  EXPECT_EQ(s[occupied], before[occupied]);
   double total_m = 0.0, total_s = 0.0;
   for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
   {
@@ -456,7 +459,8 @@ TEST(MotionSteps, TrackBoxInteriorCellsGiveOnlyFromTheSetsThatHoldTheClass)
     const std::vector<float> before = massesOf(run.grid, c);
     double moved = 0.0;
     for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
-      if (a != FrameMG::kV && (a & FrameMG::kV)) moved += 0.5 * before[a];
+      if (a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0)
+        moved += 0.5 * before[a];
     run.grid.applyTrackedMotion({ CellMotion{ c, CellClass::kMoving, 0.5f, true } });
     const std::vector<float> after = massesOf(run.grid, c);
     double total = 0.0;
@@ -464,7 +468,7 @@ TEST(MotionSteps, TrackBoxInteriorCellsGiveOnlyFromTheSetsThatHoldTheClass)
     {
       EXPECT_GE(after[a], 0.0f);
       total += after[a];
-      const bool gives = a != FrameMG::kV && (a & FrameMG::kV);
+      const bool gives = a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0;
       if (a == FrameMG::kV)
         EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
       else

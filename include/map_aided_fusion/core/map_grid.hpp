@@ -335,14 +335,12 @@ public:
   /**
    * @brief Step "track evidence" (not in the paper): the motion of tracked objects in their cells, after update().
    *
-   * kMoving with weight β moves β·m(A) to {V} from every focal set A of the cell with V ∈ A (including those that
-   * hold C or N: the free-space check showed that the object moved, so it is no pole) or A ⊆ {F, S} (a mover where
-   * space was free or an object stopped, as the paper's ⊛ sends the free-to-occupied conflict to V). kStopped moves
-   * β·m(A) to {S} from A ⊆ {F, S, V} with S ∈ A or A ⊆ {F, V} only: a stopped track cannot tell a parked car from a
-   * pole, so the static classes stay the prior's and the counter's. For an interior cell (CellMotion::interior) only
-   * the sets holding the target give. Each transfer keeps the total: the result is a mass function. BetP and
-   * decisions of the listed cells are computed again; a kOccupied cell decided S or V is then decided
-   * CellClass::kOccupied (an object whose motion is not yet known is neither).
+   * kMoving with weight β moves β·m(A) to {V} from every focal set A ⊆ {F, S, V} of the cell with V ∈ A or
+   * A ⊆ {F, S} (a mover where space was free or an object stopped, as the paper's ⊛ sends the free-to-occupied
+   * conflict to V); kStopped likewise to {S} (S ∈ A or A ⊆ {F, V}). Sets holding C or N are left alone: the static
+   * classes stay the prior's and the counter's (measured: moving evidence on them lets false moving tracks on poles
+   * and trees take N). Each transfer keeps the total: the result is a mass function. BetP and decisions of the listed cells are computed again; a kOccupied cell decided S or V is
+   * then decided CellClass::kOccupied (an object whose motion is not yet known is neither).
    */
   void applyTrackedMotion(const std::vector<CellMotion>& cells);
   /// The decision of every cell after the last update (decide() with these parameters, written in the fusion pass
