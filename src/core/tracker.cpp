@@ -375,14 +375,16 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
   {
     // It left: the returns of one earlier sighting lie in the free space of this scan.
     const SeenFree& current = seen_free_.back();
-    for (const Sighting& past : t.sightings)
-      t.motion_seen = t.motion_seen || current.clearShare(past.points) >= params_.free_space_share;
+    const bool left = std::any_of(t.sightings.begin(), t.sightings.end(), [&](const Sighting& past) {
+      return current.clearShare(past.points) >= params_.free_space_share;
+    });
     // It came: its returns of this scan lie where some earlier scan saw free space.
-    std::size_t came = 0;
-    for (const Point2& q : now.points)
-      came += std::any_of(seen_free_.begin(), seen_free_.end() - 1, [&](const SeenFree& f) { return f.clear(q); });
-    t.motion_seen = t.motion_seen || (!now.points.empty() && static_cast<double>(came) >=
-                                                                 params_.free_space_share * static_cast<double>(now.points.size()));
+    auto seenFreeBefore = [&](const Point2& q) {
+      return std::any_of(seen_free_.begin(), seen_free_.end() - 1, [&](const SeenFree& f) { return f.clear(q); });
+    };
+    const auto came = std::count_if(now.points.begin(), now.points.end(), seenFreeBefore);
+    t.motion_seen = left || (!now.points.empty() && static_cast<double>(came) >=
+                                                        params_.free_space_share * static_cast<double>(now.points.size()));
   }
   const double oldest = stamp - params_.free_space_time - kMinStep;
   t.sightings.erase(std::remove_if(t.sightings.begin(), t.sightings.end(),
