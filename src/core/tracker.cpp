@@ -21,6 +21,7 @@ constexpr double kTinySpeed = 1e-6;    // m/s: below, the speed's direction is u
 constexpr double kMinStep = 1e-6;      // s between two scans
 constexpr double kMaxDenseCells = 4e6;  // cells of the dense clustering grid (16 MB of indices) before a hash map
 constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
+constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
 
@@ -65,6 +66,8 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_share", free_space_share, kMinShare, 1.0);
   requireInRange("tracker_free_space_margin", free_space_margin, 0.0, kMaxCellSize);
   requireInRange("tracker_free_space_time", free_space_time, kMinStep, kMaxFreeSpaceTime);
+  requireInRange("tracker_heading_box_angle", heading_box_angle, 0.0, kMaxHeadingBoxAngle);
+  requireInRange("tracker_heading_box_max_length", heading_box_max_length, 0.0, max_object_length);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -305,6 +308,21 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
+  if (params_.heading_box && t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed &&
+      std::max(t.extent_length, t.extent_width) <= params_.heading_box_max_length)
+  {
+    const double heading = std::atan2(t.x(3), t.x(2));
+    const double off = std::remainder(heading - t.extent_yaw, 0.5 * M_PI);
+    if (std::abs(off) > params_.heading_box_angle * M_PI / 180.0)
+    {
+      t.extent_yaw = heading;
+      const Eigen::Vector2d tu(std::cos(heading), std::sin(heading)), tv(-tu.y(), tu.x());
+      const AxisView a = viewAlong(m, tu), b = viewAlong(m, tv);
+      t.extent_length = a.hi - a.lo;
+      t.extent_width = b.hi - b.lo;
+      t.x.head<2>() = Eigen::Vector2d(m.centroid.x, m.centroid.y) + 0.5 * (a.lo + a.hi) * tu + 0.5 * (b.lo + b.hi) * tv;
+    }
+  }
   if (anchored(t, m))
   {
     // A longer cluster than the box: the box grows away from the sensor; its centre moves, the object does not.

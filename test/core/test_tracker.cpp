@@ -503,3 +503,94 @@ TEST(Tracker, FreeSpaceParametersAreValidatedByName)
     }
   }
 }
+
+namespace {
+
+/// A box of @p length × @p width driving at 5 m/s from (10, 0) past a sensor at the origin, straight for 1 s, then
+/// turning by @p turn_deg per scan for 8 scans, then straight again: 3 s at 10 Hz, the whole outline seen. Returns
+/// the ids of the track followed (the one nearest the object) scan after scan, and that track at the end.
+std::vector<std::uint32_t> driveAndTurn(const TrackerParams& params, double length, double width, double turn_deg,
+                                        Track& last)
+{
+  Tracker tracker(params);
+  std::vector<std::uint32_t> ids;
+  double x = 10.0, y = 0.0, heading = 0.0;
+  constexpr double kSpeed = 5.0, kDt = 0.1;
+  for (int k = 0; k < 30; ++k)
+  {
+    if (k >= 10 && k < 18) heading += turn_deg * M_PI / 180.0;
+    x += kSpeed * kDt * std::cos(heading);
+    y += kSpeed * kDt * std::sin(heading);
+    std::vector<float> xy;
+    for (const Point2& p : boxOutline(x, y, heading, length, width))
+    {
+      xy.push_back(static_cast<float>(p.x));
+      xy.push_back(static_cast<float>(p.y));
+    }
+    tracker.update(kDt * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ xy.data(), xy.size() / 2 });
+    const Track* nearest = nullptr;
+    for (const Track& t : tracker.tracks())
+      if (!nearest || std::hypot(t.x(0) - x, t.x(1) - y) < std::hypot(nearest->x(0) - x, nearest->x(1) - y))
+        nearest = &t;
+    if (nearest && k >= 3) ids.push_back(nearest->id);
+    if (nearest) last = *nearest;
+  }
+  return ids;
+}
+
+}  // namespace
+
+TEST(Tracker, HeadingBoxTurnsTheBoxOfAShortObjectThatTurns)
+{
+  TrackerParams on, off;
+  off.heading_box = false;
+  Track with, without;
+  // A cyclist (1.6 × 0.6 m) turning by 48° in all.
+  const std::vector<std::uint32_t> ids = driveAndTurn(on, 1.6, 0.6, 6.0, with);
+  driveAndTurn(off, 1.6, 0.6, 6.0, without);
+  ASSERT_FALSE(ids.empty());
+  for (const std::uint32_t id : ids) EXPECT_EQ(id, ids.front()) << "one id all along";
+  EXPECT_EQ(with.motion, TrackMotion::kMoving);
+  // Its box turned with it: its axes within heading_box_angle of the heading (48°), so its width is at most that of the
+  // outline seen that much askew, 0.6 cos a + 1.6 sin a (plus the outline's 0.1 m spacing).
+  const double a = on.heading_box_angle * M_PI / 180.0;
+  const double askew_width = 0.6 * std::cos(a) + 1.6 * std::sin(a) + 0.1;
+  EXPECT_LE(std::abs(std::remainder(with.extent_yaw - 48.0 * M_PI / 180.0, 0.5 * M_PI)), a + 1e-9);
+  EXPECT_LE(std::min(with.extent_length, with.extent_width), askew_width);
+  EXPECT_NEAR(std::max(with.extent_length, with.extent_width), 1.6, 0.25);
+  // Without the step the box keeps its first axes and grows wider than that to hold the outline.
+  EXPECT_NEAR(std::remainder(without.extent_yaw, 0.5 * M_PI), 0.0, 0.05);
+  EXPECT_GT(std::min(without.extent_length, without.extent_width), askew_width);
+}
+
+TEST(Tracker, HeadingBoxLeavesTheBoxOfALongObjectAlone)
+{
+  TrackerParams on;
+  Track van;
+  // A van (5 × 2 m), longer than heading_box_max_length: its box keeps the axes of its first cluster.
+  driveAndTurn(on, 5.0, 2.0, 6.0, van);
+  EXPECT_NEAR(std::remainder(van.extent_yaw, 0.5 * M_PI), 0.0, 0.05);
+}
+
+TEST(Tracker, HeadingBoxParametersAreValidatedByName)
+{
+  for (auto [name, set] : std::vector<std::pair<std::string, void (*)(TrackerParams&)>>{
+           { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = -1.0; } },
+           { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = 50.0; } },
+           { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = -0.5; } },
+           { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = 1e3; } },
+           { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = std::nan(""); } } })
+  {
+    TrackerParams p;
+    set(p);
+    try
+    {
+      p.validate();
+      ADD_FAILURE() << name << " accepted";
+    }
+    catch (const ParameterError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}

@@ -61,6 +61,14 @@ struct TrackerParams
   double free_space_share = 0.3;     ///< share of a sighting's returns that must lie in free space, (0, 1]
   double free_space_margin = 0.5;    ///< m: a point is in free space when every ScanGrid cell this near was seen free
   double free_space_time = 1.0;      ///< s: how far back sightings and scans are compared
+  /// Step "heading box": a track's box keeps the axes of its first cluster, so an object that turns is seen askew in
+  /// them: its box grows (a cyclist's to 1.7 × 1.6 m) and the point followed slides off the object until the gate
+  /// loses it. A moving track's box no longer than heading_box_max_length turns to its heading, from the cluster of
+  /// that scan, once it is askew by more than heading_box_angle. A longer object is seldom seen whole (a van behind
+  /// a car): the middle of its cluster is not its box's, so its box keeps its axes.
+  bool heading_box = true;
+  double heading_box_angle = 20.0;      ///< deg in [0, 45]: the box turns when its axes are this far from the heading
+  double heading_box_max_length = 2.5;  ///< m: only boxes no longer than this turn (cyclists, pedestrians)
   /// Step "track evidence" (core/track_evidence.hpp): the weight w of a track's motion in its cells' masses,
   /// β = w · P(motion); 0: off.
   double evidence_weight = 0.8;
@@ -101,6 +109,9 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_free_space_share", p.free_space_share, { "", "share of a sighting's returns that must lie in free space" });
   get("tracker_free_space_margin", p.free_space_margin, { "m", "a point is in free space when every ScanGrid cell this near (whole cells) was seen free" });
   get("tracker_free_space_time", p.free_space_time, { "s", "how far back the free-space check compares sightings and scans" });
+  get("tracker_heading_box", p.heading_box, { "", "step heading box: a short moving track's box turns to its heading once askew" });
+  get("tracker_heading_box_angle", p.heading_box_angle, { "deg", "the box turns when its axes are this far from the track's heading" });
+  get("tracker_heading_box_max_length", p.heading_box_max_length, { "m", "only boxes no longer than this turn to the heading" });
   get("tracker_evidence_weight", p.evidence_weight, { "", "step track evidence: weight w of a track's motion in its cells (β = w·P(motion)); 0: off" });
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
 }
