@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -80,10 +81,18 @@ TEST(Tracker, ClustersAreObjectsAndWallsAreNot)
   for (double x = 0.0; x <= 20.0; x += 0.1) pts.push_back(Point2{ x, 15.0 });  // a 20 m wall
   pts.push_back(Point2{ -30.0, -30.0 });                                       // a lone return
   pts.push_back(Point2{ std::nan(""), 1.0 });
+  const auto bus = boxOutline(40.0, -10.0, 0.0, 12.0, 2.5);  // a bus is an object, shorter than max_object_length
+  pts.insert(pts.end(), bus.begin(), bus.end());
   const auto m = clusterReturns(pts, p);
-  ASSERT_EQ(m.size(), 2u);
-  const Measurement& car = std::abs(m[0].centroid.x - 10.0) < 1.0 ? m[0] : m[1];
-  const Measurement& walker = &car == &m[0] ? m[1] : m[0];
+  ASSERT_EQ(m.size(), 3u);
+  auto near = [&](double x) -> const Measurement& {
+    return *std::min_element(m.begin(), m.end(), [&](const Measurement& a, const Measurement& b) {
+      return std::abs(a.centroid.x - x) < std::abs(b.centroid.x - x);
+    });
+  };
+  const Measurement& car = near(10.0);
+  const Measurement& walker = near(20.0);
+  EXPECT_NEAR(near(40.0).length, 12.0, 0.15);
   EXPECT_NEAR(car.centroid.x, 10.0, 0.05);
   EXPECT_NEAR(car.centroid.y, 5.0, 0.05);
   EXPECT_NEAR(car.length, 4.0, 0.15);

@@ -37,7 +37,7 @@ struct TrackerParams
   /// … and a cluster with more than this share of its returns on background is no moving-object candidate, not
   /// tracked; 1: off.
   double background_share = 0.5;
-  double max_object_length = 8.0;    ///< m: a longer cluster (a wall, a fence, a hedge) is no object
+  double max_object_length = 18.0;   ///< m: a longer cluster (a wall, a fence, a hedge) is no object; an articulated bus is shorter
   double max_object_width = 4.0;     ///< m: a wider cluster is no object
   double measurement_sigma = 0.15;   ///< m, standard deviation of a compact cluster's centroid
   double extent_sigma = 0.1;         ///< m of standard deviation per metre of the cluster's extent on that axis
