@@ -51,6 +51,9 @@ const std::vector<AddedStep>& addedSteps()
     { "track_box", "track evidence also in the cells of a track's box that hold none of its returns",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box; },
       [](Profile& p) { p.tracker.evidence_box = false; } },
+    { "hidden_length", "a moving vehicle seen end-on: its track box extends away from the sensor to a vehicle's length",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box && p.tracker.evidence_hidden_length > 0.0; },
+      [](Profile& p) { p.tracker.evidence_hidden_length = 0.0; } },
   };
   return steps;
 }

@@ -47,6 +47,35 @@ void addBoxInterior(const Measurement& m, const GridGeometry& g, CellMotion c, s
     }
 }
 
+/// Step "hidden length": @p m's box in its heading's axes, extended away from the sensor along @p heading to
+/// @p length when it is at least @p end_width wide across the heading and shallower than @p length along it; @p m
+/// itself otherwise.
+Measurement withHiddenLength(const Measurement& m, double heading, double length, double end_width)
+{
+  if (!m.has_sensor || !(length > 0.0)) return m;
+  const double hu = std::cos(heading), hv = std::sin(heading), cu = std::cos(m.yaw), su = std::sin(m.yaw);
+  double lu = 1e300, uu = -1e300, lv = 1e300, uv = -1e300;
+  for (double u : { m.lo_u, m.hi_u })
+    for (double v : { m.lo_v, m.hi_v })
+    {
+      const double x = u * cu - v * su, y = u * su + v * cu;
+      const double a = x * hu + y * hv, b = -x * hv + y * hu;
+      lu = std::min(lu, a);
+      uu = std::max(uu, a);
+      lv = std::min(lv, b);
+      uv = std::max(uv, b);
+    }
+  if (uu - lu >= length || uv - lv < end_width) return m;
+  const bool behind = (m.sensor.x - m.centroid.x) * hu + (m.sensor.y - m.centroid.y) * hv < 0.0;
+  Measurement e = m;
+  e.yaw = heading;
+  e.lo_u = behind ? lu : uu - length;
+  e.hi_u = behind ? lu + length : uu;
+  e.lo_v = lv;
+  e.hi_v = uv;
+  return e;
+}
+
 }  // namespace
 
 double motionProbability(const Track& t, const TrackerParams& p)
@@ -92,7 +121,14 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
                           [](const CellMotion& a, const CellMotion& b) { return a.cell == b.cell; }),
               out.end());
     if (p.evidence_box && c.motion != CellClass::kOccupied)
-      addBoxInterior(measurements[t.measurement], g, c, first, out);
+    {
+      const Measurement& m = measurements[t.measurement];
+      if (c.motion == CellClass::kMoving && t.speed() > 0.0)
+        addBoxInterior(withHiddenLength(m, std::atan2(t.x(3), t.x(2)), p.evidence_hidden_length, p.evidence_end_width),
+                       g, c, first, out);
+      else
+        addBoxInterior(m, g, c, first, out);
+    }
   }
   return out;
 }

@@ -66,6 +66,8 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_share", free_space_share, kMinShare, 1.0);
   requireInRange("tracker_free_space_margin", free_space_margin, 0.0, kMaxCellSize);
   requireInRange("tracker_free_space_time", free_space_time, kMinStep, kMaxFreeSpaceTime);
+  requireInRange("tracker_evidence_hidden_length", evidence_hidden_length, 0.0, max_object_length);
+  requireInRange("tracker_evidence_end_width", evidence_end_width, 0.0, max_object_width);
   requireInRange("tracker_heading_box_angle", heading_box_angle, 0.0, kMaxHeadingBoxAngle);
   requireInRange("tracker_heading_box_max_length", heading_box_max_length, 0.0, max_object_length);
 }

@@ -603,3 +603,97 @@ TEST(Tracker, HeadingBoxParametersAreValidatedByName)
     }
   }
 }
+
+namespace {
+
+/// The cells of track evidence of a face (@p width m wide across y = 5, two rows of returns every 0.1 m) that drives along x at
+/// 8 m/s for 9 scans from @p x0 (direction @p dir, ±1), seen from the origin; @p face_x receives its last x.
+std::vector<CellMotion> faceEvidence(const TrackerParams& params, const GridGeometry& g, double x0, double dir,
+                                     double width, double& face_x)
+{
+  Tracker tracker(params);
+  for (int k = 0; k <= 8; ++k)
+  {
+    face_x = x0 + dir * 0.8 * k;
+    std::vector<float> xy;
+    for (double y = 5.0 - 0.5 * width; y <= 5.0 + 0.5 * width + 1e-9; y += 0.1)
+      for (const double dx : { 0.0, 0.05 })
+      {
+        xy.push_back(static_cast<float>(face_x + dx));
+        xy.push_back(static_cast<float>(y));
+      }
+    tracker.update(0.1 * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  }
+  EXPECT_EQ(tracker.tracks().size(), 1u);
+  if (tracker.tracks().size() != 1u) return {};
+  EXPECT_EQ(tracker.tracks()[0].motion, TrackMotion::kMoving);
+  return trackEvidence(tracker, g);
+}
+
+/// How many of @p cells lie, by their centre, with x in [x_lo, x_hi] and y within @p half of 5.
+std::size_t cellsIn(const std::vector<CellMotion>& cells, const GridGeometry& g, double x_lo, double x_hi, double half)
+{
+  std::size_t n = 0;
+  for (const CellMotion& c : cells)
+  {
+    const Point2 q = g.cellCentre(CellIndex{ static_cast<int>(c.cell % g.width), static_cast<int>(c.cell / g.width) });
+    n += q.x >= x_lo && q.x <= x_hi && std::abs(q.y - 5.0) <= half;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
+{
+  const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
+  TrackerParams p;
+  const double len = p.evidence_hidden_length, margin = 0.3;  // cells well inside or well outside, at 0.5 m
+  // The body lies away from the sensor (at the origin: +x) behind a rear face (the vehicle drives away) and behind a
+  // front face (it drives towards the sensor): every cell of the 4 m × 1.8 m box.
+  for (const double dir : { 1.0, -1.0 })
+  {
+    double face = 0.0;
+    const auto cells = faceEvidence(p, g, dir > 0 ? 10.0 : 30.0, dir, 1.8, face);
+    const double far_lo = face + margin, far_hi = face + len - margin;
+    // Cell centres every 0.5 m in [far_lo, far_hi] along x, and the two rows within 0.5 m of y = 5 (4.75, 5.25).
+    const std::size_t inside = static_cast<std::size_t>(std::floor(far_hi / 0.5 - 0.5) - std::ceil(far_lo / 0.5 - 0.5) + 1) * 2;
+    EXPECT_GE(cellsIn(cells, g, far_lo, far_hi, 0.5), inside) << "direction " << dir;
+    // Nothing beyond the length, nothing on the sensor's side of the face.
+    EXPECT_EQ(cellsIn(cells, g, face + len + margin, 1e9, 5.0), 0u) << "direction " << dir;
+    EXPECT_EQ(cellsIn(cells, g, -1e9, face - margin, 5.0), 0u) << "direction " << dir;
+    for (const CellMotion& c : cells) EXPECT_EQ(c.motion, CellClass::kMoving);
+  }
+  // A face narrower than evidence_end_width (a cyclist's), or the step off: the box is the face only.
+  double face = 0.0;
+  const auto narrow = faceEvidence(p, g, 10.0, 1.0, 0.6, face);
+  EXPECT_FALSE(narrow.empty());
+  EXPECT_EQ(cellsIn(narrow, g, face + margin, 1e9, 5.0), 0u);
+  TrackerParams off;
+  off.evidence_hidden_length = 0.0;
+  const auto without = faceEvidence(off, g, 10.0, 1.0, 1.8, face);
+  EXPECT_FALSE(without.empty());
+  EXPECT_EQ(cellsIn(without, g, face + margin, 1e9, 5.0), 0u);
+}
+
+TEST(Tracker, HiddenLengthParametersAreValidatedByName)
+{
+  for (auto [name, set] : std::vector<std::pair<std::string, void (*)(TrackerParams&)>>{
+           { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = -1.0; } },
+           { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = 1e3; } },
+           { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },
+           { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } } })
+  {
+    TrackerParams p;
+    set(p);
+    try
+    {
+      p.validate();
+      ADD_FAILURE() << name << " accepted";
+    }
+    catch (const ParameterError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}

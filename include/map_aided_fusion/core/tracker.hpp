@@ -75,6 +75,12 @@ struct TrackerParams
   /// … given also to the cells of its measurement's box that hold none of its returns (seen over or hidden behind
   /// the object's near side), from the sets that already hold the track's class only.
   bool evidence_box = true;
+  /// Step "hidden length": a moving track seen end-on (its cluster at least evidence_end_width wide across its
+  /// heading and shallower than evidence_hidden_length along it: a car's rear or front face) has its box, for the
+  /// track box, extended away from the sensor along its heading to evidence_hidden_length m; 0: off. The body behind
+  /// the face holds no return (the rays end on the face or pass over the roof) and otherwise keeps the prior.
+  double evidence_hidden_length = 4.0;
+  double evidence_end_width = 1.4;  ///< m: the narrowest face that is a vehicle's end (a cyclist's is narrower)
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -113,6 +119,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_heading_box_angle", p.heading_box_angle, { "deg", "the box turns when its axes are this far from the track's heading" });
   get("tracker_heading_box_max_length", p.heading_box_max_length, { "m", "only boxes no longer than this turn to the heading" });
   get("tracker_evidence_weight", p.evidence_weight, { "", "step track evidence: weight w of a track's motion in its cells (β = w·P(motion)); 0: off" });
+  get("tracker_evidence_hidden_length", p.evidence_hidden_length, { "m", "step hidden length: a moving track seen end-on has its box extended away from the sensor to this length; 0: off" });
+  get("tracker_evidence_end_width", p.evidence_end_width, { "m", "the narrowest face that is a vehicle's end (step hidden length)" });
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
 }
 
