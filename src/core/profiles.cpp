@@ -54,6 +54,9 @@ const std::vector<AddedStep>& addedSteps()
     { "hidden_length", "a moving vehicle seen end-on: its track box extends away from the sensor to a vehicle's length",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box && p.tracker.evidence_hidden_length > 0.0; },
       [](Profile& p) { p.tracker.evidence_hidden_length = 0.0; } },
+    { "box_hidden", "the box cells of a moving track that the scan did not see free also move their free mass to V",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box && p.tracker.evidence_box_hidden; },
+      [](Profile& p) { p.tracker.evidence_box_hidden = false; } },
   };
   return steps;
 }

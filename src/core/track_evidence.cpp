@@ -90,6 +90,22 @@ double motionProbability(const Track& t, const TrackerParams& p)
   return 0.0;
 }
 
+void markHidden(std::vector<CellMotion>& cells, const GridGeometry& g, const ScanMassGrid& scan, const Pose2& pose)
+{
+  const GridGeometry& sg = scan.geometry();
+  const float* const f = scan.plane(FrameSG::kF);
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  for (CellMotion& m : cells)
+  {
+    if (!m.interior || m.motion != CellClass::kMoving || m.cell >= g.numCells()) continue;
+    const Point2 q = g.cellCentre(CellIndex{ static_cast<int>(m.cell % static_cast<std::size_t>(g.width)),
+                                             static_cast<int>(m.cell / static_cast<std::size_t>(g.width)) });
+    const double dx = q.x - pose.x, dy = q.y - pose.y;
+    CellIndex ci;
+    m.hidden = !sg.worldToCell(Point2{ c * dx + s * dy, -s * dx + c * dy }, ci) || !(f[sg.index(ci)] > 0.0f);
+  }
+}
+
 std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry& g)
 {
   std::vector<CellMotion> out;
@@ -145,7 +161,9 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
                   },
                   background);
   tracker.update(stamp, pose, returns, &background, scan);
-  grid.applyTrackedMotion(trackEvidence(tracker, g));
+  std::vector<CellMotion> cells = trackEvidence(tracker, g);
+  if (scan && tracker.params().evidence_box_hidden) markHidden(cells, g, *scan, pose);
+  grid.applyTrackedMotion(cells);
 }
 
 }  // namespace core

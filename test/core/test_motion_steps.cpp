@@ -10,6 +10,7 @@
 #include "map_aided_fusion/core/map_grid.hpp"
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
+#include "map_aided_fusion/core/track_evidence.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -482,6 +483,75 @@ TEST(MotionSteps, TrackBoxInteriorCellsGiveOnlyFromTheSetsThatHoldTheClass)
     }
     else
       EXPECT_GT(moved, 0.1) << "the hidden cell's {F, S, V} gives to V";
+  }
+}
+
+TEST(MotionSteps, BoxHiddenCellsAlsoGiveTheirFreeSetsToV)
+{
+  core::Run run(defaultProfile());
+  seeCarOnRoad(run);
+  const GridGeometry& g = run.grid.geometry();
+  CellIndex ci;
+  ASSERT_TRUE(g.worldToCell(Point2{ 8.1, 0.1 }, ci));  // seen free in front of the car: mass on {F}
+  const std::size_t c = g.index(ci);
+  const std::vector<float> before = massesOf(run.grid, c);
+  ASSERT_GT(before[FrameMG::kF], 0.5f);
+  // Hidden (the scan did not see it free): every set within {F, S, V} that holds V or lies within {F, S} gives β of
+  // its mass to V, as a cell of the track's returns does; sets holding C or N keep theirs.
+  double moved = 0.0;
+  auto gives = [](Subset a) {
+    return a != FrameMG::kV && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0 &&
+           ((a & FrameMG::kV) || (a & ~(FrameMG::kF | FrameMG::kS)) == 0);
+  };
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+    if (gives(a)) moved += 0.5 * before[a];
+  CellMotion m{ c, CellClass::kMoving, 0.5f, true };
+  m.hidden = true;
+  run.grid.applyTrackedMotion({ m });
+  const std::vector<float> after = massesOf(run.grid, c);
+  double total = 0.0;
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+  {
+    EXPECT_GE(after[a], 0.0f);
+    total += after[a];
+    if (a == FrameMG::kV)
+      EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
+    else
+      EXPECT_NEAR(after[a], gives(a) ? 0.5 * before[a] : before[a], 1e-6) << subsetName<FrameMG>(a);
+  }
+  EXPECT_NEAR(total, 1.0, 1e-5);
+  EXPECT_NEAR(after[FrameMG::kF], 0.5 * before[FrameMG::kF], 1e-6) << "its stale free mass gives half to V";
+}
+
+TEST(MotionSteps, MarkHiddenFlagsTheInteriorCellsTheScanDidNotSeeFree)
+{
+  const GridGeometry g{ 0.5, 40, 40, -10.0, -10.0 };
+  ScanMassGrid scan(GridGeometry::centred(20.0, 20.0, 0.5));
+  const GridGeometry& sg = scan.geometry();
+  // The vehicle at (2, 1) heading 90°: the scan sees free the vehicle-frame half-plane x < 3 (map y < 4).
+  const Pose2 pose{ 2.0, 1.0, M_PI / 2 };
+  for (int y = 0; y < sg.height; ++y)
+    for (int x = 0; x < sg.width; ++x)
+      if (sg.cellCentre(CellIndex{ x, y }).x < 3.0)
+      {
+        scan.plane(FrameSG::kF)[sg.index(CellIndex{ x, y })] = 0.7f;
+        scan.plane(FrameSG::kOmega)[sg.index(CellIndex{ x, y })] = 0.3f;
+      }
+  std::vector<CellMotion> cells;
+  for (const double my : { 2.1, 6.1 })
+    for (const bool interior : { true, false })
+      for (const CellClass k : { CellClass::kMoving, CellClass::kStopped })
+      {
+        CellIndex ci;
+        ASSERT_TRUE(g.worldToCell(Point2{ 2.1, my }, ci));
+        CellMotion m{ g.index(ci), k, 0.5f, interior };
+        cells.push_back(m);
+      }
+  markHidden(cells, g, scan, pose);
+  for (const CellMotion& m : cells)
+  {
+    const bool behind = g.cellCentre(CellIndex{ static_cast<int>(m.cell % 40), static_cast<int>(m.cell / 40) }).y > 4.0;
+    EXPECT_EQ(m.hidden, behind && m.interior && m.motion == CellClass::kMoving);
   }
 }
 

@@ -184,6 +184,9 @@ struct CellMotion
   /// A cell of the object's box holding none of its returns (seen over, or hidden behind, its near side): only sets
   /// that hold the target class move, so that space seen free stays free.
   bool interior = false;
+  /// An interior cell that this scan did not see free (hidden behind the object's near side, or seen over): its free
+  /// evidence is older than the object, so sets within {F, the other motion} move too, as in a cell of its returns.
+  bool hidden = false;
 };
 
 /// An object made of a connected region of moving or stopped cells.

@@ -30,6 +30,14 @@ double motionProbability(const Track& track, const TrackerParams& params);
 std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry& geometry);
 
 /**
+ * @brief Step "box hidden": marks hidden (CellMotion::hidden) the interior cells of moving tracks in @p cells (cells of
+ *        @p geometry) that the scan's ScanGrid @p scan (vehicle frame, vehicle pose @p pose in the map frame) did not
+ *        see free (m(F) = 0 at the cell's centre, or outside the ScanGrid).
+ */
+void markHidden(std::vector<CellMotion>& cells, const GridGeometry& geometry, const ScanMassGrid& scan,
+                const Pose2& pose);
+
+/**
  * @brief One scan of tracking after @p grid's update(): flags the returns on static background (the grid's counter ζ
  *        above background_zeta, backgroundFlags()), updates @p tracker with the scan's ScanGrid @p scan (vehicle
  *        frame; the free space of step free-space check, nullptr: none), and applies its evidence to @p grid
