@@ -345,6 +345,27 @@ std::vector<float> massesOf(const MapGrid& g, std::size_t i)
   return m;
 }
 
+/// Checks one cell's masses after a transfer of β = 0.5 to {V}: every set for which @p gives is true kept half its mass,
+/// V gained it all, every other set kept its own; masses ≥ 0 summing to 1. Returns the mass moved.
+template <class Gives>
+double expectHalfMovedToV(const std::vector<float>& before, const std::vector<float>& after, Gives&& gives)
+{
+  double moved = 0.0, total = 0.0;
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+    if (gives(a)) moved += 0.5 * before[a];
+  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+  {
+    EXPECT_GE(after[a], 0.0f);
+    total += after[a];
+    if (a == FrameMG::kV)
+      EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
+    else
+      EXPECT_NEAR(after[a], gives(a) ? 0.5 * before[a] : before[a], 1e-6) << subsetName<FrameMG>(a);
+  }
+  EXPECT_NEAR(total, 1.0, 1e-5);
+  return moved;
+}
+
 /// Four scans of a car 10 m ahead (x 10 to 14 m, y ±1 m) on a road (prior {F, S, V} everywhere), seen from the origin.
 void seeCarOnRoad(Run& run)
 {
@@ -458,24 +479,11 @@ TEST(MotionSteps, TrackBoxInteriorCellsGiveOnlyFromTheSetsThatHoldTheClass)
   for (std::size_t c : { seen, hidden })
   {
     const std::vector<float> before = massesOf(run.grid, c);
-    double moved = 0.0;
-    for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
-      if (a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0)
-        moved += 0.5 * before[a];
     run.grid.applyTrackedMotion({ CellMotion{ c, CellClass::kMoving, 0.5f, true } });
     const std::vector<float> after = massesOf(run.grid, c);
-    double total = 0.0;
-    for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
-    {
-      EXPECT_GE(after[a], 0.0f);
-      total += after[a];
-      const bool gives = a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0;
-      if (a == FrameMG::kV)
-        EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
-      else
-        EXPECT_NEAR(after[a], gives ? 0.5 * before[a] : before[a], 1e-6) << subsetName<FrameMG>(a);
-    }
-    EXPECT_NEAR(total, 1.0, 1e-5);
+    const double moved = expectHalfMovedToV(before, after, [](Subset a) {
+      return a != FrameMG::kV && (a & FrameMG::kV) && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0;
+    });
     if (c == seen)
     {
       EXPECT_GT(before[FrameMG::kF], 0.5f) << "seen free";
@@ -498,28 +506,16 @@ TEST(MotionSteps, BoxHiddenCellsAlsoGiveTheirFreeSetsToV)
   ASSERT_GT(before[FrameMG::kF], 0.5f);
   // Hidden (the scan did not see it free): every set within {F, S, V} that holds V or lies within {F, S} gives β of
   // its mass to V, as a cell of the track's returns does; sets holding C or N keep theirs.
-  double moved = 0.0;
-  auto gives = [](Subset a) {
-    return a != FrameMG::kV && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0 &&
-           ((a & FrameMG::kV) || (a & ~(FrameMG::kF | FrameMG::kS)) == 0);
-  };
-  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
-    if (gives(a)) moved += 0.5 * before[a];
   CellMotion m{ c, CellClass::kMoving, 0.5f, true };
   m.hidden = true;
   run.grid.applyTrackedMotion({ m });
   const std::vector<float> after = massesOf(run.grid, c);
-  double total = 0.0;
-  for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
-  {
-    EXPECT_GE(after[a], 0.0f);
-    total += after[a];
-    if (a == FrameMG::kV)
-      EXPECT_NEAR(after[a], before[a] + moved, 1e-6);
-    else
-      EXPECT_NEAR(after[a], gives(a) ? 0.5 * before[a] : before[a], 1e-6) << subsetName<FrameMG>(a);
-  }
-  EXPECT_NEAR(total, 1.0, 1e-5);
+  EXPECT_GT(expectHalfMovedToV(before, after,
+                               [](Subset a) {
+                                 return a != FrameMG::kV && (a & ~(FrameMG::kF | FrameMG::kS | FrameMG::kV)) == 0 &&
+                                        ((a & FrameMG::kV) || (a & ~(FrameMG::kF | FrameMG::kS)) == 0);
+                               }),
+            0.0);
   EXPECT_NEAR(after[FrameMG::kF], 0.5 * before[FrameMG::kF], 1e-6) << "its stale free mass gives half to V";
 }
 

@@ -48,6 +48,25 @@ const Track* byId(const Tracker& t, std::uint32_t id)
   return nullptr;
 }
 
+/// Each case breaks one parameter; validate() must refuse it with an error naming it.
+void expectRefusedByName(const std::vector<std::pair<std::string, void (*)(TrackerParams&)>>& cases)
+{
+  for (const auto& [name, set] : cases)
+  {
+    TrackerParams p;
+    set(p);
+    try
+    {
+      p.validate();
+      ADD_FAILURE() << name << " accepted";
+    }
+    catch (const ParameterError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 
 TEST(Tracker, ParametersAreValidatedByName)
@@ -492,25 +511,12 @@ TEST(Tracker, FreeSpaceCheckTellsAMoverFromAWallFragmentThatSlidesAlong)
 
 TEST(Tracker, FreeSpaceParametersAreValidatedByName)
 {
-  for (auto [name, set] : std::vector<std::pair<std::string, void (*)(TrackerParams&)>>{
-           { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
-           { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
-           { "tracker_free_space_margin", [](TrackerParams& p) { p.free_space_margin = -0.1; } },
-           { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = 0.0; } },
-           { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } } })
-  {
-    TrackerParams p;
-    set(p);
-    try
-    {
-      p.validate();
-      ADD_FAILURE() << name << " accepted";
-    }
-    catch (const ParameterError& e)
-    {
-      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
-    }
-  }
+  expectRefusedByName({
+      { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
+      { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
+      { "tracker_free_space_margin", [](TrackerParams& p) { p.free_space_margin = -0.1; } },
+      { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = 0.0; } },
+      { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } } });
 }
 
 namespace {
@@ -583,25 +589,12 @@ TEST(Tracker, HeadingBoxLeavesTheBoxOfALongObjectAlone)
 
 TEST(Tracker, HeadingBoxParametersAreValidatedByName)
 {
-  for (auto [name, set] : std::vector<std::pair<std::string, void (*)(TrackerParams&)>>{
-           { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = -1.0; } },
-           { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = 50.0; } },
-           { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = -0.5; } },
-           { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = 1e3; } },
-           { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = std::nan(""); } } })
-  {
-    TrackerParams p;
-    set(p);
-    try
-    {
-      p.validate();
-      ADD_FAILURE() << name << " accepted";
-    }
-    catch (const ParameterError& e)
-    {
-      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
-    }
-  }
+  expectRefusedByName({
+      { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = -1.0; } },
+      { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = 50.0; } },
+      { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = -0.5; } },
+      { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = 1e3; } },
+      { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = std::nan(""); } } });
 }
 
 namespace {
@@ -678,22 +671,9 @@ TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
 
 TEST(Tracker, HiddenLengthParametersAreValidatedByName)
 {
-  for (auto [name, set] : std::vector<std::pair<std::string, void (*)(TrackerParams&)>>{
-           { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = -1.0; } },
-           { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = 1e3; } },
-           { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },
-           { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } } })
-  {
-    TrackerParams p;
-    set(p);
-    try
-    {
-      p.validate();
-      ADD_FAILURE() << name << " accepted";
-    }
-    catch (const ParameterError& e)
-    {
-      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
-    }
-  }
+  expectRefusedByName({
+      { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = -1.0; } },
+      { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = 1e3; } },
+      { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },
+      { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } } });
 }
