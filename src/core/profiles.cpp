@@ -52,10 +52,10 @@ const std::vector<AddedStep>& addedSteps()
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box; },
       [](Profile& p) { p.tracker.evidence_box = false; } },
     { "hidden_length", "a moving vehicle seen end-on: its track box extends away from the sensor to a vehicle's length",
-      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box && p.tracker.evidence_hidden_length > 0.0; },
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_hidden_length > 0.0; },
       [](Profile& p) { p.tracker.evidence_hidden_length = 0.0; } },
     { "box_hidden", "the box cells of a moving track that the scan did not see free also move their free mass to V",
-      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box && p.tracker.evidence_box_hidden; },
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box_hidden; },
       [](Profile& p) { p.tracker.evidence_box_hidden = false; } },
   };
   return steps;
@@ -64,6 +64,29 @@ const std::vector<AddedStep>& addedSteps()
 Profile withoutAddedSteps(Profile p)
 {
   for (const AddedStep& s : addedSteps()) s.disable(p);
+  return p;
+}
+
+namespace {
+
+constexpr double kCarSelfBoxRear = -2.7;   // m, x of the car's rear from the lidar
+constexpr double kCarSelfBoxFront = 1.8;   // m, x of its front (bonnet and mirrors) from the lidar
+constexpr double kCarSelfBoxHalfWidth = 1.7;  // m, half its width with the mirrors, and a margin
+
+}  // namespace
+
+void carSelfBox(ScanGridParams& p)
+{
+  p.self_box_min_x = kCarSelfBoxRear;
+  p.self_box_max_x = kCarSelfBoxFront;
+  p.self_box_min_y = -kCarSelfBoxHalfWidth;
+  p.self_box_max_y = kCarSelfBoxHalfWidth;
+}
+
+Profile defaultProfile()
+{
+  Profile p;
+  carSelfBox(p.scan_grid);
   return p;
 }
 

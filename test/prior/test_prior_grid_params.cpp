@@ -227,7 +227,9 @@ TEST(Profiles, IbeoScanGridDiffersFromTheDefaultOnlyWhereTheSensorNeedsIt)
   std::set<std::string> differ;
   for (const auto& kv : a)
     if (b.at(kv.first) != kv.second) differ.insert(kv.first);
-  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "ground_model", "relative_height_limit" }));
+  // The self box too: a sensor on the front bumper sees none of its vehicle.
+  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "ground_model", "relative_height_limit",
+                                            "self_box_max_x", "self_box_max_y", "self_box_min_x", "self_box_min_y" }));
   EXPECT_EQ(ibeo.groundModel(), core::GroundModel::kFlat);
   EXPECT_EQ(ibeo.grid_resolution, 0.5) << "the paper's cells";
   EXPECT_EQ(ibeo.grid_size_x, 100.0) << "the paper's window";

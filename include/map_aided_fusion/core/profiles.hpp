@@ -45,8 +45,14 @@ const std::vector<AddedStep>& addedSteps();
 /// The paper's method: every added step off, the paper's α, β, δ, γ, μ.
 Profile paperProfile();
 
-/// This package's default (the structs' defaults, the files of config/).
-inline Profile defaultProfile() { return Profile{}; }
+/// This package's default (the files of config/): the structs' defaults, and the self box of a passenger car with
+/// its lidar on the roof (carSelfBox()).
+Profile defaultProfile();
+
+/// Sets @p p's self box to a passenger car's with its lidar on the roof, base_link on the ground under the lidar:
+/// x in [−2.7, 1.8] m, y in [−1.7, 1.7] m (KITTI's car returns its own roof edges and mirrors up to 1.6 m beside
+/// the lidar). The paper's profile has none.
+void carSelfBox(ScanGridParams& p);
 
 /// @p p with every step this package adds to the paper switched off (the rest unchanged).
 Profile withoutAddedSteps(Profile p);
