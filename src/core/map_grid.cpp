@@ -845,7 +845,8 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
     // Only sets within {F, S, V}: the static classes stay the prior's and the counter's (a false moving track on a
     // pole must not take its N).
     const unsigned dynamic = FrameMG::kF | FrameMG::kS | FrameMG::kV;
-    const unsigned agreeing = c.interior && !c.hidden ? 0u : FrameMG::kF | other;  // sets within {F, other} go to the target
+    // Sets within {F, other} go to the target, except in a box cell the scan saw free.
+    const unsigned agreeing = c.interior && !c.hidden ? 0u : FrameMG::kF | other;
     float mass[kernels::kSubsets];
     kernels::loadMasses(base, c.cell, mass);
     float to_target = 0.0f;

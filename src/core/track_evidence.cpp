@@ -53,26 +53,16 @@ void addBoxInterior(const Measurement& m, const GridGeometry& g, CellMotion c, s
 Measurement withHiddenLength(const Measurement& m, double heading, double length, double end_width)
 {
   if (!m.has_sensor || !(length > 0.0)) return m;
-  const double hu = std::cos(heading), hv = std::sin(heading), cu = std::cos(m.yaw), su = std::sin(m.yaw);
-  double lu = 1e300, uu = -1e300, lv = 1e300, uv = -1e300;
-  for (double u : { m.lo_u, m.hi_u })
-    for (double v : { m.lo_v, m.hi_v })
-    {
-      const double x = u * cu - v * su, y = u * su + v * cu;
-      const double a = x * hu + y * hv, b = -x * hv + y * hu;
-      lu = std::min(lu, a);
-      uu = std::max(uu, a);
-      lv = std::min(lv, b);
-      uv = std::max(uv, b);
-    }
-  if (uu - lu >= length || uv - lv < end_width) return m;
-  const bool behind = (m.sensor.x - m.centroid.x) * hu + (m.sensor.y - m.centroid.y) * hv < 0.0;
+  const Eigen::Vector2d along(std::cos(heading), std::sin(heading)), across(-along.y(), along.x());
+  const AxisView u = viewAlong(m, along), v = viewAlong(m, across);
+  if (u.hi - u.lo >= length || v.hi - v.lo < end_width) return m;
+  const bool behind = (m.sensor.x - m.centroid.x) * along.x() + (m.sensor.y - m.centroid.y) * along.y() < 0.0;
   Measurement e = m;
   e.yaw = heading;
-  e.lo_u = behind ? lu : uu - length;
-  e.hi_u = behind ? lu + length : uu;
-  e.lo_v = lv;
-  e.hi_v = uv;
+  e.lo_u = behind ? u.lo : u.hi - length;
+  e.hi_u = behind ? u.lo + length : u.hi;
+  e.lo_v = v.lo;
+  e.hi_v = v.hi;
   return e;
 }
 
@@ -98,8 +88,7 @@ void markHidden(std::vector<CellMotion>& cells, const GridGeometry& g, const Sca
   for (CellMotion& m : cells)
   {
     if (!m.interior || m.motion != CellClass::kMoving || m.cell >= g.numCells()) continue;
-    const Point2 q = g.cellCentre(CellIndex{ static_cast<int>(m.cell % static_cast<std::size_t>(g.width)),
-                                             static_cast<int>(m.cell / static_cast<std::size_t>(g.width)) });
+    const Point2 q = g.cellCentre(g.cellOf(m.cell));
     const double dx = q.x - pose.x, dy = q.y - pose.y;
     CellIndex ci;
     m.hidden = !sg.worldToCell(Point2{ c * dx + s * dy, -s * dx + c * dy }, ci) || !(f[sg.index(ci)] > 0.0f);

@@ -211,16 +211,6 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
   return out;
 }
 
-namespace {
-
-/// The cluster of @p m seen along @p axis: its interval relative to the centroid and whether its low end is the one
-/// nearest the sensor.
-struct AxisView
-{
-  double lo = 0.0, hi = 0.0;
-  bool near_lo = true;
-};
-
 AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis)
 {
   const Eigen::Vector2d mu(std::cos(m.yaw), std::sin(m.yaw)), mv(-mu.y(), mu.x());
@@ -236,6 +226,8 @@ AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis)
   a.near_lo = sensor.dot(axis) < 0.5 * (a.lo + a.hi);
   return a;
 }
+
+namespace {
 
 bool anchored(const Track& t, const Measurement& m)
 {

@@ -546,7 +546,7 @@ TEST(MotionSteps, MarkHiddenFlagsTheInteriorCellsTheScanDidNotSeeFree)
   markHidden(cells, g, scan, pose);
   for (const CellMotion& m : cells)
   {
-    const bool behind = g.cellCentre(CellIndex{ static_cast<int>(m.cell % 40), static_cast<int>(m.cell / 40) }).y > 4.0;
+    const bool behind = g.cellCentre(g.cellOf(m.cell)).y > 4.0;
     EXPECT_EQ(m.hidden, behind && m.interior && m.motion == CellClass::kMoving);
   }
 }

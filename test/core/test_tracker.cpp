@@ -629,7 +629,7 @@ std::size_t cellsIn(const std::vector<CellMotion>& cells, const GridGeometry& g,
   std::size_t n = 0;
   for (const CellMotion& c : cells)
   {
-    const Point2 q = g.cellCentre(CellIndex{ static_cast<int>(c.cell % g.width), static_cast<int>(c.cell / g.width) });
+    const Point2 q = g.cellCentre(g.cellOf(c.cell));
     n += q.x >= x_lo && q.x <= x_hi && std::abs(q.y - 5.0) <= half;
   }
   return n;

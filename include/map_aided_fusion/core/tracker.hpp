@@ -162,6 +162,17 @@ struct Measurement
   std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
 };
 
+/// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
+/// one nearest the sensor.
+struct AxisView
+{
+  double lo = 0.0, hi = 0.0;
+  bool near_lo = true;
+};
+
+/// The box of @p m (its four corners) seen along the unit vector @p axis (map frame).
+AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis);
+
 /**
  * @brief Clusters map-frame returns: cells of cluster_distance / 2 holding returns, 8-connected, are one cluster.
  *        Clusters with fewer than min_cluster_points returns, longer than max_object_length or wider than
