@@ -179,8 +179,35 @@ void BM_ProjectScan(benchmark::State& state)
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(kN) * kN);
 }
 
+/// MapGrid::shift() of an 800 × 800 window at 0.2 m by 25 columns and 3 rows, then back (a recentring after 5 m):
+/// the masses and ζ; with Arg skip, also the flags of skip_unchanged and what a skipped block keeps. Args: threads,
+/// skip.
+void BM_MapGridShift(benchmark::State& state)
+{
+  constexpr int kN = 800;
+  constexpr double kRes = 0.2;
+  constexpr int kColumns = 25, kRows = 3;
+  MapGridParams params;
+  params.threads = static_cast<int>(state.range(0));
+  params.skip_unchanged = state.range(1) != 0;
+  params.size_x = params.size_y = kN * kRes;
+  params.resolution = kRes;
+  MapGrid grid(params);
+  grid.update(benchScan(kN, kRes), Pose2{}, 0.0, nullptr);
+  int sign = 1;
+  for (auto _ : state)
+  {
+    grid.shift(sign * kColumns, sign * kRows);
+    sign = -sign;
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(kN) * kN);
+}
+
 }  // namespace
 
+BENCHMARK(BM_MapGridShift)->ArgsProduct({ { 1, 2 }, { 0, 1 } })->ArgNames({ "threads", "skip" })->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MapGridUpdate)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MapGridUpdateReturns)->ArgsProduct({ { 200, 800 }, { 1, 2 } })->ArgNames({ "n", "threads" })->UseRealTime()

@@ -30,6 +30,8 @@ ROWS = [
     (DRIVE.format(n=800, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=800, t=2, s=0), "skipped_share"),
     (DRIVE.format(n=200, t=2, s=0), "the realistic drive, 200 × 200 at 0.5 m, 2 threads, `skip_unchanged` off", None),
     (DRIVE.format(n=200, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=200, t=2, s=0), "skipped_share"),
+    ("BM_MapGridShift/threads:2/skip:0/real_time", "moving the 800 × 800 window by 25 columns and 3 rows (a recentring after 5 m): masses and ζ, 2 threads", "BM_MapGridUpdate/n:800/threads:2/real_time"),
+    ("BM_MapGridShift/threads:2/skip:1/real_time", "the same with what `skip_unchanged` keeps (flags, the prior they hold for, BetP, decisions)", "BM_MapGridShift/threads:2/skip:0/real_time"),
     ("BM_FusionStep/n:800/threads:2/real_time", "the fused step alone (refine, prior, discounting, ⊛, counter, BetP)", "BM_MapGridUpdate/n:800/threads:2/real_time"),
     ("BM_StreamBaseline/n:800/threads:2/real_time", "the fused step's bytes, streamed once", "BM_FusionStep/n:800/threads:2/real_time"),
     ("BM_ProjectScan/clearance:5/threads:2/real_time", "the scan's projection with a 1 m obstacle clearance", "BM_MapGridUpdate/n:800/threads:2/real_time"),

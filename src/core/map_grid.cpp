@@ -514,7 +514,8 @@ void MapGrid::reset()
 namespace {
 
 /// Moves one plane of a @p g-sized window by whole cells (see MapGrid::shift), filling vacated cells with @p fill.
-void shiftPlane(float* p, const GridGeometry& g, int dx, int dy, float fill)
+template <typename T>
+void shiftPlane(T* p, const GridGeometry& g, int dx, int dy, T fill)
 {
   const std::size_t w = static_cast<std::size_t>(g.width);
   const int x0 = std::max(0, -dx), x1 = std::min(g.width, g.width - dx);
@@ -523,15 +524,15 @@ void shiftPlane(float* p, const GridGeometry& g, int dx, int dy, float fill)
   for (int k = 0; k < g.height; ++k)
   {
     const int y = forward ? k : g.height - 1 - k;
-    float* row = p + static_cast<std::size_t>(y) * w;
+    T* row = p + static_cast<std::size_t>(y) * w;
     const int sy = y + dy;
     if (sy < 0 || sy >= g.height)
     {
       std::fill(row, row + w, fill);
       continue;
     }
-    const float* src = p + static_cast<std::size_t>(sy) * w;
-    std::memmove(row + x0, src + x0 + dx, count * sizeof(float));
+    const T* src = p + static_cast<std::size_t>(sy) * w;
+    std::memmove(row + x0, src + x0 + dx, count * sizeof(T));
     std::fill(row, row + x0, fill);
     std::fill(row + x1, row + w, fill);
   }
@@ -607,10 +608,51 @@ void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par)
 
 }  // namespace
 
+void MapGrid::shiftStable(int dx, int dy)
+{
+  const GridGeometry& g = grid_.geometry();
+  constexpr std::size_t kB = MapMassGrid::kBlockCells;
+  const std::size_t n = g.numCells();
+  const bool whole_rows = g.width % static_cast<int>(kB) == 0 && std::abs(dx) < g.width && std::abs(dy) < g.height;
+  if (stable_.empty() || !whole_rows || kept_[0].size() != n || betp_.p[0].size() != n || decision_.size() != n)
+  {
+    forgetStable();  // BetP and the decisions stay where they were until the next step writes them
+    return;
+  }
+  // A block stays stable when every one of its cells comes from a stable block: the flag holds cell by cell.
+  const std::vector<std::uint8_t> was = stable_;
+  const std::size_t w = static_cast<std::size_t>(g.width), blocks_per_row = w / kB;
+  for (int y = 0; y < g.height; ++y)
+  {
+    const int sy = y + dy;
+    for (std::size_t bx = 0; bx < blocks_per_row; ++bx)
+    {
+      const long x0 = static_cast<long>(bx * kB) + dx, x1 = x0 + static_cast<long>(kB) - 1;
+      bool stable = sy >= 0 && sy < g.height && x0 >= 0 && x1 < g.width;
+      if (stable)
+      {
+        const std::size_t row = static_cast<std::size_t>(sy) * w;
+        stable = was[(row + static_cast<std::size_t>(x0)) / kB] && was[(row + static_cast<std::size_t>(x1)) / kB];
+      }
+      stable_[static_cast<std::size_t>(y) * blocks_per_row + bx] = stable;
+    }
+  }
+  // What a skipped block keeps moves with it: its kept prior, BetP and decision (vacated cells are computed next).
+  constexpr int kPlanes = 4 + FrameMG::kSize;
+  parallel_->forChunks(kPlanes + 1, [&](std::size_t k) {
+    if (k < 4)
+      shiftPlane(kept_[k].data(), g, dx, dy, 0.0f);
+    else if (k < kPlanes)
+      shiftPlane(betp_.p[k - 4].data(), g, dx, dy, 1.0f / FrameMG::kSize);
+    else
+      shiftPlane(decision_.data(), g, dx, dy, static_cast<std::int8_t>(CellClass::kUnknown));
+  });
+}
+
 void MapGrid::shift(int dx, int dy)
 {
   if (dx == 0 && dy == 0) return;
-  forgetStable();  // BetP and the decisions stay where they were until the next step writes them
+  shiftStable(dx, dy);
   const GridGeometry g = grid_.geometry();
   grid_.setOrigin(g.origin_x + dx * g.resolution, g.origin_y + dy * g.resolution);
   if (std::abs(dx) >= g.width || std::abs(dy) >= g.height)

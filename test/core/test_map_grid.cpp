@@ -106,13 +106,16 @@ class MapGridShift : public ::testing::TestWithParam<double>
 // Widths of 40 cells (rows of whole blocks: rows moved as blocks) and 41 (the cell-by-cell path).
 INSTANTIATE_TEST_SUITE_P(BlockRowsAndAnyWidth, MapGridShift, ::testing::Values(20.0, 20.5));
 
-TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
+namespace {
+
+void expectShiftsKeepMassesBitExact(double size_x, int threads)
 {
   MapGridParams params = defaultParams();
-  params.size_x = GetParam();
+  params.size_x = size_x;
   params.size_y = 15.0;
+  params.threads = threads;
   MapGrid mg(params);
-  ASSERT_EQ(mg.geometry().width % 8 == 0, GetParam() == 20.0);
+  ASSERT_EQ(mg.geometry().width % 8 == 0, size_x == 20.0);
   std::mt19937 rng(3);
   auto& grid = mg.mutableMasses();
   for (std::size_t i = 0; i < grid.numCells(); ++i)
@@ -121,7 +124,8 @@ TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
     grid.zeta(i) = static_cast<float>(i % 17) / 17.0f;
   }
   const MapMassGrid before = grid;
-  for (auto [dx, dy] : { std::pair{ 3, -2 }, std::pair{ -5, 0 }, std::pair{ 0, 4 }, std::pair{ 1, 1 }, std::pair{ -16, 3 } })
+  for (auto [dx, dy] : { std::pair{ 3, -2 }, std::pair{ -5, 0 }, std::pair{ 0, 4 }, std::pair{ 1, 1 }, std::pair{ -16, 3 },
+                         std::pair{ 0, -9 }, std::pair{ 7, 9 }, std::pair{ -2, 12 }, std::pair{ 0, -12 } })
   {
     MapGrid moved = mg;
     moved.shift(dx, dy);
@@ -159,6 +163,18 @@ TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
   far.shift(1000, 0);
   for (std::size_t i = 0; i < far.masses().numCells(); ++i)
     ASSERT_TRUE(maf_test::massNear(far.masses().cell(i), MassMG::vacuous(), 0.0));
+}
+
+}  // namespace
+
+TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
+{
+  // One to three threads (rows of blocks move in parallel), by up to 16 columns and 12 of the 30 rows.
+  for (int threads : { 1, 2, 3 })
+  {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    expectShiftsKeepMassesBitExact(GetParam(), threads);
+  }
 }
 
 TEST(ProjectScan, RotatedWindowSamplesTheScanCellUnderEachCellCentre)

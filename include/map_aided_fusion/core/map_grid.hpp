@@ -314,7 +314,9 @@ public:
 
   /**
    * @brief Moves the window by whole cells: the cell at (x, y) moves to (x − dx, y − dy) and the origin by
-   *        (dx, dy) cells. Masses and ζ are moved bit-exactly.
+   *        (dx, dy) cells. Masses and ζ are moved bit-exactly; with skip_unchanged, the flags of the skipped blocks
+   *        move too, with BetP and the decisions, so that the next update still skips what stayed unchanged
+   *        (vacated cells are vacuous and computed by it).
    */
   void shift(int dx, int dy);
 
@@ -382,6 +384,9 @@ private:
 
   void forgetStable() { std::fill(stable_.begin(), stable_.end(), std::uint8_t{ 0 }); }
   void forgetStable(const std::vector<std::size_t>& cells);
+  /// shift()'s move of the flags and of what a skipped block keeps (kept prior, BetP, decision), before the masses
+  /// move; or forgetStable() where the flags cannot follow (no flags, rows of part blocks, a jump past the window).
+  void shiftStable(int dx, int dy);
   /// The StepSkip of this update (flags sized, cleared when the inputs' kind changed), or nullptr when it is off.
   const StepSkip* prepareSkip(bool has_prior, bool has_doubt, StepSkip& skip);
 };
