@@ -52,11 +52,14 @@ const std::vector<AddedStep>& addedSteps()
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box; },
       [](Profile& p) { p.tracker.evidence_box = false; } },
     { "hidden_length", "a moving vehicle seen end-on: its track box extends away from the sensor to a vehicle's length",
-      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_hidden_length > 0.0; },
-      [](Profile& p) { p.tracker.evidence_hidden_length = 0.0; } },
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.hidden_length && p.tracker.evidence_hidden_length > 0.0; },
+      [](Profile& p) { p.tracker.hidden_length = false; } },
     { "box_hidden", "the box cells of a moving track that the scan did not see free also move their free mass to V",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_box_hidden; },
       [](Profile& p) { p.tracker.evidence_box_hidden = false; } },
+    { "hidden_centre", "a moving vehicle seen end-on is reported at the centre of the box of step hidden_length, not of its face",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.hidden_centre && p.tracker.evidence_hidden_length > 0.0; },
+      [](Profile& p) { p.tracker.hidden_centre = false; } },
   };
   return steps;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace map_aided_fusion {
 namespace core {
@@ -48,14 +49,14 @@ void addBoxInterior(const Measurement& m, const GridGeometry& g, CellMotion c, s
 }
 
 /// Step "hidden length": @p m's box in its heading's axes, extended away from the sensor along @p heading to
-/// @p length when it is at least @p end_width wide across the heading and shallower than @p length along it; @p m
-/// itself otherwise.
-Measurement withHiddenLength(const Measurement& m, double heading, double length, double end_width)
+/// @p length when it is at least @p end_width wide across the heading and shallower than @p length along it; nothing
+/// otherwise.
+std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading, double length, double end_width)
 {
-  if (!m.has_sensor || !(length > 0.0)) return m;
+  if (!m.has_sensor || !(length > 0.0)) return std::nullopt;
   const Eigen::Vector2d along(std::cos(heading), std::sin(heading)), across(-along.y(), along.x());
   const AxisView u = viewAlong(m, along), v = viewAlong(m, across);
-  if (u.hi - u.lo >= length || v.hi - v.lo < end_width) return m;
+  if (u.hi - u.lo >= length || v.hi - v.lo < end_width) return std::nullopt;
   const bool behind = (m.sensor.x - m.centroid.x) * along.x() + (m.sensor.y - m.centroid.y) * along.y() < 0.0;
   Measurement e = m;
   e.yaw = heading;
@@ -66,7 +67,39 @@ Measurement withHiddenLength(const Measurement& m, double heading, double length
   return e;
 }
 
+double heading(const Track& t) { return std::atan2(t.x(3), t.x(2)); }
+
 }  // namespace
+
+ObjectBox reportedBox(const Track& t, const Tracker& tracker)
+{
+  ObjectBox b{ t.position(), t.extent_yaw, t.extent_length, t.extent_width };
+  const TrackerParams& p = tracker.params();
+  const std::vector<Measurement>& measurements = tracker.measurements();
+  if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0) || t.measurement < 0 ||
+      t.measurement >= static_cast<int>(measurements.size()))
+    return b;
+  const Measurement& m = measurements[t.measurement];
+  const std::optional<Measurement> e = hiddenLengthBox(m, heading(t), p.evidence_hidden_length, p.evidence_end_width);
+  if (!e) return b;
+  const double cu = 0.5 * (e->lo_u + e->hi_u), cv = 0.5 * (e->lo_v + e->hi_v);
+  const double c = std::cos(e->yaw), s = std::sin(e->yaw);
+  const Point2 followed = referencePoint(t, m);
+  b.centre = Point2{ t.x(0) + m.centroid.x + cu * c - cv * s - followed.x,
+                     t.x(1) + m.centroid.y + cu * s + cv * c - followed.y };
+  b.yaw = e->yaw;
+  b.length = e->hi_u - e->lo_u;
+  b.width = e->hi_v - e->lo_v;
+  return b;
+}
+
+std::vector<ObjectBox> reportedBoxes(const Tracker& tracker)
+{
+  std::vector<ObjectBox> out;
+  out.reserve(tracker.tracks().size());
+  for (const Track& t : tracker.tracks()) out.push_back(reportedBox(t, tracker));
+  return out;
+}
 
 double motionProbability(const Track& t, const TrackerParams& p)
 {
@@ -129,7 +162,9 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     {
       const Measurement& m = measurements[t.measurement];
       if (c.motion == CellClass::kMoving && t.speed() > 0.0)
-        addBoxInterior(withHiddenLength(m, std::atan2(t.x(3), t.x(2)), p.evidence_hidden_length, p.evidence_end_width),
+        addBoxInterior(hiddenLengthBox(m, heading(t), p.hidden_length ? p.evidence_hidden_length : 0.0,
+                                       p.evidence_end_width)
+                           .value_or(m),
                        g, c, first, out);
       else
         addBoxInterior(m, g, c, first, out);

@@ -491,9 +491,12 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
         const eval::ClassGrid* valid = object_mode ? nearest(valid_masks, cloud->header.stamp) : nullptr;
         std::vector<eval::MotHypothesis> hypotheses;
         for (const core::Track& tr : v->tracker->tracks())
+        {
+          const core::Point2 centre = core::reportedBox(tr, *v->tracker).centre;
           if (tr.reported() && tr.motion == core::TrackMotion::kMoving &&
-              (!object_mode || (valid && valid->at(tr.position()) > 0)))
-            hypotheses.push_back(eval::MotHypothesis{ tr.id, tr.position(), true, tr.velocity() });
+              (!object_mode || (valid && valid->at(centre) > 0)))
+            hypotheses.push_back(eval::MotHypothesis{ tr.id, centre, true, tr.velocity() });
+        }
         v->scores.tracks.addFrame(eval::motObjects(*objects, sightings, v->scores.movers), hypotheses);
       };
       v->last_prior = pw;

@@ -622,7 +622,8 @@ void FusionWorker::track(const std_msgs::Header& header, double stamp, const cor
   }
   if (tracks_pub_.getNumSubscribers() + tracks_markers_pub_.getNumSubscribers() == 0) return;
   auto tracks = boost::make_shared<TrackedObjectArray>();
-  Visualization::tracksToMessage(tracker_->tracks(), header, stamp, node_params_.object_box_height, *tracks);
+  Visualization::tracksToMessage(tracker_->tracks(), header, stamp, node_params_.object_box_height, *tracks,
+                                 core::reportedBoxes(*tracker_));
   if (tracks_markers_pub_.getNumSubscribers() > 0)
   {
     auto markers = boost::make_shared<visualization_msgs::MarkerArray>();

@@ -135,26 +135,30 @@ void Visualization::objectsToMarkers(const std::vector<core::GridObject>& object
 }
 
 void Visualization::tracksToMessage(const std::vector<core::Track>& tracks, const std_msgs::Header& header, double now,
-                                    double box_height, TrackedObjectArray& out)
+                                    double box_height, TrackedObjectArray& out, const std::vector<core::ObjectBox>& boxes)
 {
   out.header = header;
   out.objects.clear();
-  for (const core::Track& t : tracks)
+  for (std::size_t i = 0; i < tracks.size(); ++i)
   {
+    const core::Track& t = tracks[i];
     if (!t.reported()) continue;
+    const core::ObjectBox b = boxes.size() == tracks.size()
+                                  ? boxes[i]
+                                  : core::ObjectBox{ t.position(), t.extent_yaw, t.extent_length, t.extent_width };
     TrackedObject o;
     o.id = t.id;
     o.cell_class = t.motion == core::TrackMotion::kMoving    ? TrackedObject::MOVING
                    : t.motion == core::TrackMotion::kStopped ? TrackedObject::STOPPED
                                                              : TrackedObject::MOTION_UNKNOWN;
     o.state = t.state == core::TrackState::kCoasting ? TrackedObject::COASTING : TrackedObject::CONFIRMED;
-    o.pose.position.x = t.x(0);
-    o.pose.position.y = t.x(1);
+    o.pose.position.x = b.centre.x;
+    o.pose.position.y = b.centre.y;
     o.pose.position.z = 0.5 * box_height;
-    o.pose.orientation.z = std::sin(0.5 * t.extent_yaw);
-    o.pose.orientation.w = std::cos(0.5 * t.extent_yaw);
-    o.size.x = t.extent_length;
-    o.size.y = t.extent_width;
+    o.pose.orientation.z = std::sin(0.5 * b.yaw);
+    o.pose.orientation.w = std::cos(0.5 * b.yaw);
+    o.size.x = b.length;
+    o.size.y = b.width;
     o.size.z = box_height;
     o.velocity.x = t.x(2);
     o.velocity.y = t.x(3);

@@ -601,8 +601,8 @@ namespace {
 
 /// The cells of track evidence of a face (@p width m wide across y = 5, two rows of returns every 0.1 m) that drives along x at
 /// 8 m/s for 9 scans from @p x0 (direction @p dir, ±1), seen from the origin; @p face_x receives its last x.
-std::vector<CellMotion> faceEvidence(const TrackerParams& params, const GridGeometry& g, double x0, double dir,
-                                     double width, double& face_x)
+/// The tracker of faceEvidence()'s drive.
+Tracker faceTracker(const TrackerParams& params, double x0, double dir, double width, double& face_x)
 {
   Tracker tracker(params);
   for (int k = 0; k <= 8; ++k)
@@ -617,6 +617,13 @@ std::vector<CellMotion> faceEvidence(const TrackerParams& params, const GridGeom
       }
     tracker.update(0.1 * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ xy.data(), xy.size() / 2 });
   }
+  return tracker;
+}
+
+std::vector<CellMotion> faceEvidence(const TrackerParams& params, const GridGeometry& g, double x0, double dir,
+                                     double width, double& face_x)
+{
+  const Tracker tracker = faceTracker(params, x0, dir, width, face_x);
   EXPECT_EQ(tracker.tracks().size(), 1u);
   if (tracker.tracks().size() != 1u) return {};
   EXPECT_EQ(tracker.tracks()[0].motion, TrackMotion::kMoving);
@@ -662,11 +669,66 @@ TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
   const auto narrow = faceEvidence(p, g, 10.0, 1.0, 0.6, face);
   EXPECT_FALSE(narrow.empty());
   EXPECT_EQ(cellsIn(narrow, g, face + margin, 1e9, 5.0), 0u);
-  TrackerParams off;
-  off.evidence_hidden_length = 0.0;
-  const auto without = faceEvidence(off, g, 10.0, 1.0, 1.8, face);
-  EXPECT_FALSE(without.empty());
-  EXPECT_EQ(cellsIn(without, g, face + margin, 1e9, 5.0), 0u);
+  for (const bool length_zero : { true, false })
+  {
+    TrackerParams off;
+    if (length_zero)
+      off.evidence_hidden_length = 0.0;
+    else
+      off.hidden_length = false;
+    const auto without = faceEvidence(off, g, 10.0, 1.0, 1.8, face);
+    EXPECT_FALSE(without.empty());
+    EXPECT_EQ(cellsIn(without, g, face + margin, 1e9, 5.0), 0u) << (length_zero ? "length 0" : "step off");
+  }
+}
+
+TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)
+{
+  TrackerParams p;
+  const double len = p.evidence_hidden_length, width = 1.8, depth = 0.05;  // the face's returns: x and x + depth
+  constexpr double kTolerance = 0.2;  // m: the filtered position against the last face
+  // Driving away (the rear face) and towards the sensor (the front face): the body lies away from the sensor, so
+  // the object's centre is half the length behind the face's near side, and its box the hidden length's.
+  for (const double dir : { 1.0, -1.0 })
+  {
+    SCOPED_TRACE("direction " + std::to_string(dir));
+    double face = 0.0;
+    const Tracker tracker = faceTracker(p, dir > 0 ? 10.0 : 30.0, dir, width, face);
+    ASSERT_EQ(tracker.tracks().size(), 1u);
+    const Track& t = tracker.tracks()[0];
+    ASSERT_EQ(t.motion, TrackMotion::kMoving);
+    const ObjectBox b = reportedBox(t, tracker);
+    EXPECT_NEAR(b.centre.x, face + 0.5 * len, kTolerance);
+    EXPECT_NEAR(b.centre.y, 5.0, kTolerance);
+    EXPECT_NEAR(b.length, len, 1e-9);
+    EXPECT_NEAR(b.width, width, 1e-3);
+    EXPECT_NEAR(std::cos(b.yaw), dir, 1e-3) << "along the heading";
+    // The track still follows its face: only what it reports moved.
+    EXPECT_NEAR(t.x(0), face + 0.5 * depth, kTolerance);
+    const std::vector<ObjectBox> all = reportedBoxes(tracker);
+    ASSERT_EQ(all.size(), 1u);
+    EXPECT_EQ(all[0].centre.x, b.centre.x);
+  }
+  // A face narrower than evidence_end_width (a cyclist's), or the step off: the track's own position and box.
+  auto expectOwnBox = [](const TrackerParams& params, double width) {
+    double face = 0.0;
+    const Tracker tracker = faceTracker(params, 10.0, 1.0, width, face);
+    ASSERT_EQ(tracker.tracks().size(), 1u);
+    const Track& t = tracker.tracks()[0];
+    const ObjectBox b = reportedBox(t, tracker);
+    EXPECT_EQ(b.centre.x, t.x(0));
+    EXPECT_EQ(b.centre.y, t.x(1));
+    EXPECT_EQ(b.yaw, t.extent_yaw);
+    EXPECT_EQ(b.length, t.extent_length);
+    EXPECT_EQ(b.width, t.extent_width);
+  };
+  expectOwnBox(p, 0.6);
+  TrackerParams off = p;
+  off.hidden_centre = false;
+  expectOwnBox(off, width);
+  TrackerParams no_length = p;
+  no_length.evidence_hidden_length = 0.0;
+  expectOwnBox(no_length, width);
 }
 
 TEST(Tracker, HiddenLengthParametersAreValidatedByName)

@@ -119,6 +119,20 @@ TEST(Visualization, TracksBecomeMessagesAndMarkersWithIdVelocityAndMotion)
   EXPECT_EQ(msg.objects[1].cell_class, TrackedObject::MOTION_UNKNOWN);
   EXPECT_EQ(msg.objects[1].cell_class, static_cast<int>(CellClass::kOccupied));
 
+  // What the tracks report (core::reportedBoxes(), one per track): the pose and size come from it.
+  const std::vector<core::ObjectBox> boxes{ { { 12.0, 6.0 }, 0.25, 4.0, 1.9 }, {}, {} };
+  TrackedObjectArray reported;
+  Visualization::tracksToMessage({ moving, coasting, tentative }, h, 101.5, 1.5, reported, boxes);
+  ASSERT_EQ(reported.objects.size(), 2u);
+  EXPECT_DOUBLE_EQ(reported.objects[0].pose.position.x, 12.0);
+  EXPECT_DOUBLE_EQ(reported.objects[0].pose.position.y, 6.0);
+  EXPECT_DOUBLE_EQ(reported.objects[0].size.x, 4.0);
+  EXPECT_DOUBLE_EQ(reported.objects[0].size.y, 1.9);
+  EXPECT_NEAR(2.0 * std::atan2(reported.objects[0].pose.orientation.z, reported.objects[0].pose.orientation.w), 0.25,
+              1e-12);
+  EXPECT_DOUBLE_EQ(reported.objects[0].velocity.x, 3.0) << "the velocity stays the track's";
+  EXPECT_DOUBLE_EQ(o.pose.position.x, 10.0) << "without boxes: the track's position";
+
   visualization_msgs::MarkerArray markers;
   Visualization::tracksToMarkers(msg, markers);
   ASSERT_EQ(markers.markers.size(), 1u + 3u * 2u);

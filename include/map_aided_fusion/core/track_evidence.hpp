@@ -22,6 +22,27 @@ namespace core {
 /// than stopped_speed (stopped); 0 for a track whose motion is not decided.
 double motionProbability(const Track& track, const TrackerParams& params);
 
+/// What a track reports as its object (the tracks topic, the scoring of evaluate): centre, heading and extents.
+struct ObjectBox
+{
+  Point2 centre;
+  double yaw = 0.0;     ///< rad, map frame
+  double length = 0.0;  ///< m, along yaw
+  double width = 0.0;   ///< m, across it
+};
+
+/**
+ * @brief The object the track @p t of @p tracker reports: its position with its box (Track::extent_yaw,
+ *        extent_length, extent_width); with step hidden centre (TrackerParams::hidden_centre and
+ *        evidence_hidden_length > 0), a moving track seen end-on in its last measurement reports the box of step
+ *        hidden length along its heading, its position moved by as much as that box's centre lies from the point
+ *        the track follows (referencePoint()).
+ */
+ObjectBox reportedBox(const Track& t, const Tracker& tracker);
+
+/// reportedBox() of every track of @p tracker, in the order of Tracker::tracks().
+std::vector<ObjectBox> reportedBoxes(const Tracker& tracker);
+
 /**
  * @brief The cells of @p geometry holding the returns of the last scan of every reported track associated in that
  *        scan, with the track's motion and β. Empty when evidence_weight is 0 or the tracker was given measurements

@@ -80,11 +80,16 @@ struct TrackerParams
   /// track box, extended away from the sensor along its heading to evidence_hidden_length m; 0: off. The body behind
   /// the face holds no return (the rays end on the face or pass over the roof) and otherwise keeps the prior.
   double evidence_hidden_length = 4.0;
+  bool hidden_length = true;  ///< step "hidden length" on (it also needs evidence_hidden_length > 0)
   /// Step "box hidden": the cells of a moving track's box that the scan did not see free (behind its near side, under
   /// the rays over its roof) also move their free sets, {F} and {F, S}, to V, as a cell of its returns does: their
   /// free evidence is older than the object that drove in. Cells the scan sees free stay free.
   bool evidence_box_hidden = true;
   double evidence_end_width = 1.4;  ///< m: the narrowest face that is a vehicle's end (a cyclist's is narrower)
+  /// Step "hidden centre": a moving track seen end-on (as for step hidden length, with evidence_hidden_length > 0)
+  /// reports (reportedBox(): the tracks topic, the scoring) the box of step hidden length and its centre, half a
+  /// vehicle's length behind the face seen, instead of the face's.
+  bool hidden_centre = true;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -124,9 +129,11 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_heading_box_max_length", p.heading_box_max_length, { "m", "only boxes no longer than this turn to the heading" });
   get("tracker_evidence_weight", p.evidence_weight, { "", "step track evidence: weight w of a track's motion in its cells (β = w·P(motion)); 0: off" });
   get("tracker_evidence_hidden_length", p.evidence_hidden_length, { "m", "step hidden length: a moving track seen end-on has its box extended away from the sensor to this length; 0: off" });
+  get("tracker_hidden_length", p.hidden_length, { "", "step hidden length on (with tracker_evidence_hidden_length > 0)" });
   get("tracker_evidence_box_hidden", p.evidence_box_hidden, { "", "step box hidden: box cells the scan did not see free also move their free sets to V" });
   get("tracker_evidence_end_width", p.evidence_end_width, { "m", "the narrowest face that is a vehicle's end (step hidden length)" });
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
+  get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
 /**

@@ -16,6 +16,7 @@
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/TrackedObjectArray.h"
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/track_evidence.hpp"
 #include "map_aided_fusion/core/tracker.hpp"
 
 namespace map_aided_fusion {
@@ -45,9 +46,12 @@ public:
    * @brief The reported tracks (confirmed and coasting) as messages: id, motion (cell_class 3 stopped, 4 moving,
    *        5 not yet known), box, velocity and its covariance, age, hits. Tentative tracks are left out.
    * @param now  s, the scan's stamp (for the age)
+   * @param boxes  what each track reports as its object (core::reportedBoxes(), one per track, in order); empty: its
+   *               position and box (Track::extent_*)
    */
   static void tracksToMessage(const std::vector<core::Track>& tracks, const std_msgs::Header& header, double now,
-                              double box_height, TrackedObjectArray& out);
+                              double box_height, TrackedObjectArray& out,
+                              const std::vector<core::ObjectBox>& boxes = {});
 
   /**
    * @brief A DELETEALL, then per tracked object an oriented CUBE coloured by its motion (moving red, stopped green,
