@@ -18,6 +18,7 @@
 #include "map_aided_fusion/core/prior_uncertainty.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/sim/simulator.hpp"
+#include "window_params.hpp"
 
 using namespace map_aided_fusion;
 using namespace map_aided_fusion::core;
@@ -93,14 +94,8 @@ const Drive& drive(double resolution)
 void BM_MapGridUpdateDrive(benchmark::State& state)
 {
   const int n = static_cast<int>(state.range(0));
-  const double res = n == 200 ? 0.5 : 0.2;
-  const Drive& d = drive(res);
-  MapGridParams params;
-  params.threads = static_cast<int>(state.range(1));
-  params.skip_unchanged = state.range(2) != 0;
-  params.size_x = params.size_y = n * res;
-  params.resolution = res;
-  MapGrid grid(params);
+  const Drive& d = drive(maf_bench::windowResolution(n));
+  MapGrid grid(maf_bench::windowParams(n, static_cast<int>(state.range(1)), state.range(2) != 0));
   std::size_t k = 0;
   double skipped = 0.0;
   StageTimes sum;

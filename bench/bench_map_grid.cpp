@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "window_params.hpp"
 
 using namespace map_aided_fusion::core;
 
@@ -36,12 +37,8 @@ ScanMassGrid benchScan(int n, double res)
 void runUpdates(benchmark::State& state, bool returns)
 {
   const int n = static_cast<int>(state.range(0));
-  const double res = n == 200 ? 0.5 : 0.2;
-  MapGridParams params;
-  params.threads = static_cast<int>(state.range(1));
-  params.size_x = params.size_y = n * res;
-  params.resolution = res;
-  MapGrid grid(params);
+  const double res = maf_bench::windowResolution(n);
+  MapGrid grid(maf_bench::windowParams(n, static_cast<int>(state.range(1))));
   const ScanMassGrid scan = benchScan(n, res);
   std::vector<float> xy;
   for (std::size_t i = 0; returns && i < scan.numCells(); ++i)
@@ -101,7 +98,7 @@ void BM_MapGridUpdateReturns(benchmark::State& state) { runUpdates(state, true);
 void BM_UpdateBaseline(benchmark::State& state)
 {
   const int n = static_cast<int>(state.range(0));
-  const double res = n == 200 ? 0.5 : 0.2;
+  const double res = maf_bench::windowResolution(n);
   const Parallel parallel(static_cast<int>(state.range(1)));
   const GridGeometry window = GridGeometry::centred(n * res, n * res, res);
   MapMassGrid map(window);
@@ -185,15 +182,9 @@ void BM_ProjectScan(benchmark::State& state)
 void BM_MapGridShift(benchmark::State& state)
 {
   constexpr int kN = 800;
-  constexpr double kRes = 0.2;
   constexpr int kColumns = 25, kRows = 3;
-  MapGridParams params;
-  params.threads = static_cast<int>(state.range(0));
-  params.skip_unchanged = state.range(1) != 0;
-  params.size_x = params.size_y = kN * kRes;
-  params.resolution = kRes;
-  MapGrid grid(params);
-  grid.update(benchScan(kN, kRes), Pose2{}, 0.0, nullptr);
+  MapGrid grid(maf_bench::windowParams(kN, static_cast<int>(state.range(0)), state.range(1) != 0));
+  grid.update(benchScan(kN, maf_bench::windowResolution(kN)), Pose2{}, 0.0, nullptr);
   int sign = 1;
   for (auto _ : state)
   {
