@@ -143,6 +143,8 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
                : t.motion == TrackMotion::kStopped ? CellClass::kStopped
                                                    : CellClass::kOccupied;
     c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p));
+    c.take_n = c.motion == CellClass::kMoving && p.evidence_small_size > 0.0 &&
+               t.extent_length <= p.evidence_small_size && t.extent_width <= p.evidence_small_size;
     const std::size_t first = out.size();
     for (const int i : measurements[t.measurement].returns)
     {

@@ -519,6 +519,44 @@ TEST(MotionSteps, BoxHiddenCellsAlsoGiveTheirFreeSetsToV)
   EXPECT_NEAR(after[FrameMG::kF], 0.5 * before[FrameMG::kF], 1e-6) << "its stale free mass gives half to V";
 }
 
+// Step "small movers": a pedestrian on a pavement (prior {F, N, S, V}) holds {N, S, V}; the cells of a small moving
+// track (CellMotion::take_n) also give the sets holding N that hold V (or lie within {F, S}) to V; without the flag
+// those keep their mass.
+TEST(MotionSteps, SmallMoverCellsAlsoGiveTheirSetsHoldingN)
+{
+  World world;
+  world.boxes.push_back({ 10.0, -0.3, 10.6, 0.3, 1.7 });
+  core::Run with(defaultProfile()), without(defaultProfile());
+  const GridGeometry& g = with.grid.geometry();
+  PriorWindow pavement;
+  pavement.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
+  std::fill(pavement.other.begin(), pavement.other.end(), 0.85f);
+  for (int k = 0; k < 4; ++k)
+  {
+    with.step(world, Pose2{ 0.0, 0.0, 0.0 }, &pavement);
+    without.step(world, Pose2{ 0.0, 0.0, 0.0 }, &pavement);
+  }
+  CellIndex ci;
+  ASSERT_TRUE(g.worldToCell(Point2{ 10.1, 0.1 }, ci));
+  const std::size_t i = g.index(ci);
+  const std::vector<float> before = massesOf(with.grid, i);
+  ASSERT_EQ(massesOf(without.grid, i), before);
+  const Subset nsv = FrameMG::kN | FrameMG::kS | FrameMG::kV;
+  ASSERT_GT(before[nsv], 0.1f) << "the pavement's occupied evidence";
+  CellMotion small{ i, CellClass::kMoving, 0.5f };
+  small.take_n = true;
+  with.grid.applyTrackedMotion({ small });
+  without.grid.applyTrackedMotion({ CellMotion{ i, CellClass::kMoving, 0.5f } });
+  const std::vector<float> after = massesOf(with.grid, i);
+  expectHalfMovedToV(before, after, [](Subset a) {
+    return a != FrameMG::kV && (a & ~(FrameMG::kF | FrameMG::kN | FrameMG::kS | FrameMG::kV)) == 0 &&
+           ((a & FrameMG::kV) || (a & ~(FrameMG::kF | FrameMG::kS)) == 0);
+  });
+  EXPECT_NEAR(after[nsv], 0.5 * before[nsv], 1e-6);
+  EXPECT_EQ(massesOf(without.grid, i)[nsv], before[nsv]) << "without the flag {N, S, V} stays";
+  EXPECT_EQ(with.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
+}
+
 TEST(MotionSteps, MarkHiddenFlagsTheInteriorCellsTheScanDidNotSeeFree)
 {
   const GridGeometry g{ 0.5, 40, 40, -10.0, -10.0 };

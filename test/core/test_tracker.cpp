@@ -731,9 +731,31 @@ TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)
   expectOwnBox(no_length, width);
 }
 
+TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
+{
+  const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
+  TrackerParams p;
+  auto flags = [&](const TrackerParams& params, double width) {
+    double face = 0.0;
+    const std::vector<CellMotion> cells = faceEvidence(params, g, 10.0, 1.0, width, face);
+    std::size_t take_n = 0;
+    for (const CellMotion& c : cells) take_n += c.take_n;
+    EXPECT_FALSE(cells.empty());
+    return std::pair{ take_n, cells.size() };
+  };
+  const auto [small, small_cells] = flags(p, 0.6);  // a pedestrian's width, a face 5 cm deep
+  EXPECT_EQ(small, small_cells) << "every cell of a moving track within evidence_small_size";
+  EXPECT_EQ(flags(p, 1.8).first, 0u) << "a vehicle's face is wider";
+  TrackerParams off = p;
+  off.evidence_small_size = 0.0;
+  EXPECT_EQ(flags(off, 0.6).first, 0u) << "the step off";
+}
+
 TEST(Tracker, HiddenLengthParametersAreValidatedByName)
 {
   expectRefusedByName({
+      { "tracker_evidence_small_size", [](TrackerParams& p) { p.evidence_small_size = -0.5; } },
+      { "tracker_evidence_small_size", [](TrackerParams& p) { p.evidence_small_size = 1e3; } },
       { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = -1.0; } },
       { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = 1e3; } },
       { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },

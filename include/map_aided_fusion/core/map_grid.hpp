@@ -187,6 +187,8 @@ struct CellMotion
   /// An interior cell that this scan did not see free (hidden behind the object's near side, or seen over): its free
   /// evidence is older than the object, so sets within {F, the other motion} move too, as in a cell of its returns.
   bool hidden = false;
+  /// Sets holding N move too (step "small movers"): a pedestrian on a pavement whose prior is {N, S, V}.
+  bool take_n = false;
 };
 
 /// An object made of a connected region of moving or stopped cells.

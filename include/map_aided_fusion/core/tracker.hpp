@@ -86,6 +86,10 @@ struct TrackerParams
   /// free evidence is older than the object that drove in. Cells the scan sees free stay free.
   bool evidence_box_hidden = true;
   double evidence_end_width = 1.4;  ///< m: the narrowest face that is a vehicle's end (a cyclist's is narrower)
+  /// Step "small movers": a moving track whose box is at most this long and wide (m; a pedestrian's) also moves to
+  /// V the sets that hold N, which track evidence otherwise leaves to the prior and the counter: a pavement's prior
+  /// is {N, S, V}. 0: off.
+  double evidence_small_size = 1.0;
   /// Step "hidden centre": a moving track seen end-on (as for step hidden length, with evidence_hidden_length > 0)
   /// reports (reportedBox(): the tracks topic, the scoring) the box of step hidden length and its centre, half a
   /// vehicle's length behind the face seen, instead of the face's.
@@ -133,6 +137,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_evidence_box_hidden", p.evidence_box_hidden, { "", "step box hidden: box cells the scan did not see free also move their free sets to V" });
   get("tracker_evidence_end_width", p.evidence_end_width, { "m", "the narrowest face that is a vehicle's end (step hidden length)" });
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
+  get("tracker_evidence_small_size", p.evidence_small_size, { "m", "step small movers: a moving track at most this long and wide also moves the sets holding N to V; 0: off" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
