@@ -71,9 +71,11 @@ double heading(const Track& t) { return std::atan2(t.x(3), t.x(2)); }
 
 }  // namespace
 
+ObjectBox ownBox(const Track& t) { return ObjectBox{ t.position(), t.extent_yaw, t.extent_length, t.extent_width }; }
+
 ObjectBox reportedBox(const Track& t, const Tracker& tracker)
 {
-  ObjectBox b{ t.position(), t.extent_yaw, t.extent_length, t.extent_width };
+  ObjectBox b = ownBox(t);
   const TrackerParams& p = tracker.params();
   const std::vector<Measurement>& measurements = tracker.measurements();
   if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0) || t.measurement < 0 ||

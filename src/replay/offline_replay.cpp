@@ -492,9 +492,9 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
         std::vector<eval::MotHypothesis> hypotheses;
         for (const core::Track& tr : v->tracker->tracks())
         {
+          if (!tr.reported() || tr.motion != core::TrackMotion::kMoving) continue;
           const core::Point2 centre = core::reportedBox(tr, *v->tracker).centre;
-          if (tr.reported() && tr.motion == core::TrackMotion::kMoving &&
-              (!object_mode || (valid && valid->at(centre) > 0)))
+          if (!object_mode || (valid && valid->at(centre) > 0))
             hypotheses.push_back(eval::MotHypothesis{ tr.id, centre, true, tr.velocity() });
         }
         v->scores.tracks.addFrame(eval::motObjects(*objects, sightings, v->scores.movers), hypotheses);

@@ -143,9 +143,7 @@ void Visualization::tracksToMessage(const std::vector<core::Track>& tracks, cons
   {
     const core::Track& t = tracks[i];
     if (!t.reported()) continue;
-    const core::ObjectBox b = boxes.size() == tracks.size()
-                                  ? boxes[i]
-                                  : core::ObjectBox{ t.position(), t.extent_yaw, t.extent_length, t.extent_width };
+    const core::ObjectBox b = boxes.size() == tracks.size() ? boxes[i] : core::ownBox(t);
     TrackedObject o;
     o.id = t.id;
     o.cell_class = t.motion == core::TrackMotion::kMoving    ? TrackedObject::MOVING

@@ -751,7 +751,7 @@ TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
   EXPECT_EQ(flags(off, 0.6).first, 0u) << "the step off";
 }
 
-TEST(Tracker, HiddenLengthParametersAreValidatedByName)
+TEST(Tracker, TrackEvidenceSizeParametersAreValidatedByName)
 {
   expectRefusedByName({
       { "tracker_evidence_small_size", [](TrackerParams& p) { p.evidence_small_size = -0.5; } },

@@ -31,6 +31,9 @@ struct ObjectBox
   double width = 0.0;   ///< m, across it
 };
 
+/// The track's own box: its position with Track::extent_yaw, extent_length and extent_width.
+ObjectBox ownBox(const Track& t);
+
 /**
  * @brief The object the track @p t of @p tracker reports: its position with its box (Track::extent_yaw,
  *        extent_length, extent_width); with step hidden centre (TrackerParams::hidden_centre and

@@ -46,8 +46,8 @@ public:
    * @brief The reported tracks (confirmed and coasting) as messages: id, motion (cell_class 3 stopped, 4 moving,
    *        5 not yet known), box, velocity and its covariance, age, hits. Tentative tracks are left out.
    * @param now  s, the scan's stamp (for the age)
-   * @param boxes  what each track reports as its object (core::reportedBoxes(), one per track, in order); empty: its
-   *               position and box (Track::extent_*)
+   * @param boxes  what each track reports as its object (core::reportedBoxes(), one per track, in order); empty: each
+   *               track's own box (core::ownBox())
    */
   static void tracksToMessage(const std::vector<core::Track>& tracks, const std_msgs::Header& header, double now,
                               double box_height, TrackedObjectArray& out,
