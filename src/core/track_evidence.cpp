@@ -67,6 +67,26 @@ std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading,
   return e;
 }
 
+/// Step "small box": @p m's box in the axes of the line of sight, grown to @p size along it (away from the sensor:
+/// the rays end on the near side) and across it (on both sides); nothing when it already is that large.
+std::optional<Measurement> smallMoverBox(const Measurement& m, double size)
+{
+  if (!m.has_sensor || !(size > 0.0)) return std::nullopt;
+  const double dx = m.centroid.x - m.sensor.x, dy = m.centroid.y - m.sensor.y, r = std::hypot(dx, dy);
+  if (!(r > 0.0)) return std::nullopt;
+  const Eigen::Vector2d along(dx / r, dy / r), across(-along.y(), along.x());
+  const AxisView u = viewAlong(m, along), v = viewAlong(m, across);
+  if (u.hi - u.lo >= size && v.hi - v.lo >= size) return std::nullopt;
+  Measurement e = m;
+  e.yaw = std::atan2(along.y(), along.x());
+  e.lo_u = u.lo;
+  e.hi_u = std::max(u.hi, u.lo + size);
+  const double grow = std::max(0.0, 0.5 * (size - (v.hi - v.lo)));
+  e.lo_v = v.lo - grow;
+  e.hi_v = v.hi + grow;
+  return e;
+}
+
 double heading(const Track& t) { return std::atan2(t.x(3), t.x(2)); }
 
 }  // namespace
@@ -165,7 +185,9 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     if (p.evidence_box && c.motion != CellClass::kOccupied)
     {
       const Measurement& m = measurements[t.measurement];
-      if (c.motion == CellClass::kMoving && t.speed() > 0.0)
+      if (c.take_n && p.evidence_small_box)
+        addBoxInterior(smallMoverBox(m, p.evidence_small_size).value_or(m), g, c, first, out);
+      else if (c.motion == CellClass::kMoving && t.speed() > 0.0)
         addBoxInterior(hiddenLengthBox(m, heading(t), p.hidden_length ? p.evidence_hidden_length : 0.0,
                                        p.evidence_end_width)
                            .value_or(m),

@@ -664,9 +664,12 @@ TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
     EXPECT_EQ(cellsIn(cells, g, -1e9, face - margin, 5.0), 0u) << "direction " << dir;
     for (const CellMotion& c : cells) EXPECT_EQ(c.motion, CellClass::kMoving);
   }
-  // A face narrower than evidence_end_width (a cyclist's), or the step off: the box is the face only.
+  // A face narrower than evidence_end_width (a cyclist's), or the step off: the box is the face only (without step
+  // small box, which grows a face this small to a pedestrian's size).
   double face = 0.0;
-  const auto narrow = faceEvidence(p, g, 10.0, 1.0, 0.6, face);
+  TrackerParams no_small_box = p;
+  no_small_box.evidence_small_box = false;
+  const auto narrow = faceEvidence(no_small_box, g, 10.0, 1.0, 0.6, face);
   EXPECT_FALSE(narrow.empty());
   EXPECT_EQ(cellsIn(narrow, g, face + margin, 1e9, 5.0), 0u);
   for (const bool length_zero : { true, false })
@@ -749,6 +752,79 @@ TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
   TrackerParams off = p;
   off.evidence_small_size = 0.0;
   EXPECT_EQ(flags(off, 0.6).first, 0u) << "the step off";
+}
+
+namespace {
+
+/// The track evidence of a pedestrian's near side (0.6 m wide across y = 0, two rows of returns 5 cm apart along x)
+/// seen from the origin, walking along x at 1.5 m/s for 13 scans to x = 11.1 (@p dir 1: away from the sensor, -1:
+/// towards it).
+std::vector<CellMotion> pedestrianEvidence(const TrackerParams& params, const GridGeometry& g, double dir)
+{
+  Tracker tracker(params);
+  constexpr int kScans = 13;
+  constexpr double kLastX = 11.1, kStep = 0.15;
+  for (int k = 0; k < kScans; ++k)
+  {
+    const double x = kLastX - dir * kStep * (kScans - 1 - k);
+    std::vector<float> xy;
+    for (int j = -3; j <= 3; ++j)
+      for (const double dx : { 0.0, 0.05 })
+      {
+        xy.push_back(static_cast<float>(x + dx));
+        xy.push_back(static_cast<float>(0.1 * j));
+      }
+    tracker.update(0.1 * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  }
+  EXPECT_EQ(tracker.tracks().size(), 1u);
+  if (tracker.tracks().size() != 1u) return {};
+  EXPECT_EQ(tracker.tracks()[0].motion, TrackMotion::kMoving);
+  return trackEvidence(tracker, g);
+}
+
+/// The centres of @p cells, sorted.
+std::vector<std::pair<double, double>> centres(const std::vector<CellMotion>& cells, const GridGeometry& g)
+{
+  std::vector<std::pair<double, double>> out;
+  for (const CellMotion& c : cells)
+  {
+    const Point2 q = g.cellCentre(g.cellOf(c.cell));
+    out.emplace_back(q.x, q.y);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST(Tracker, SmallBoxCoversThePedestrianBehindItsReturns)
+{
+  const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };  // cell centres at x, y = k/2 + 1/4
+  TrackerParams p;
+  ASSERT_DOUBLE_EQ(p.evidence_small_size, 1.0);
+  // The returns (x in [11.1, 11.15], |y| <= 0.3) lie in the cells centred at (11.25, ±0.25). The box grows away from
+  // the sensor to x = 11.1 + 1 and across to |y| <= 0.5: it also holds the cells centred at (11.75, ±0.25), not those
+  // at x = 12.25 nor at |y| = 0.75. Whether the pedestrian walks away from the sensor or towards it.
+  const std::vector<std::pair<double, double>> box{ { 11.25, -0.25 }, { 11.25, 0.25 }, { 11.75, -0.25 }, { 11.75, 0.25 } };
+  for (const double dir : { 1.0, -1.0 })
+  {
+    const std::vector<CellMotion> cells = pedestrianEvidence(p, g, dir);
+    EXPECT_EQ(centres(cells, g), box) << "direction " << dir;
+    for (const CellMotion& c : cells)
+    {
+      EXPECT_EQ(c.motion, CellClass::kMoving);
+      EXPECT_TRUE(c.take_n);
+    }
+  }
+  // The step off: the cells of its returns only (the box of the returns holds no other cell centre).
+  TrackerParams off = p;
+  off.evidence_small_box = false;
+  const std::vector<std::pair<double, double>> returns_only{ { 11.25, -0.25 }, { 11.25, 0.25 } };
+  EXPECT_EQ(centres(pedestrianEvidence(off, g, 1.0), g), returns_only);
+  // Not for a track larger than evidence_small_size (a cyclist's 1.2 m wide side: not a small mover).
+  TrackerParams narrow = p;
+  narrow.evidence_small_size = 0.5;
+  EXPECT_EQ(centres(pedestrianEvidence(narrow, g, 1.0), g), returns_only);
 }
 
 TEST(Tracker, TrackEvidenceSizeParametersAreValidatedByName)

@@ -90,6 +90,10 @@ struct TrackerParams
   /// V the sets that hold N, which track evidence otherwise leaves to the prior and the counter: a pavement's prior
   /// is {N, S, V}. 0: off.
   double evidence_small_size = 1.0;
+  /// Step "small box": such a small mover's box, for the track box, is grown to evidence_small_size along the line
+  /// of sight (away from the sensor: the rays end on its near side) and across it, so that it covers the body behind
+  /// the returns.
+  bool evidence_small_box = true;
   /// Step "hidden centre": a moving track seen end-on (as for step hidden length, with evidence_hidden_length > 0)
   /// reports (reportedBox(): the tracks topic, the scoring) the box of step hidden length and its centre, half a
   /// vehicle's length behind the face seen, instead of the face's.
@@ -138,6 +142,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_evidence_end_width", p.evidence_end_width, { "m", "the narrowest face that is a vehicle's end (step hidden length)" });
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
   get("tracker_evidence_small_size", p.evidence_small_size, { "m", "step small movers: a moving track at most this long and wide also moves the sets holding N to V; 0: off" });
+  get("tracker_evidence_small_box", p.evidence_small_box, { "", "step small box: a small mover's track box is grown to tracker_evidence_small_size along and across the line of sight" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
