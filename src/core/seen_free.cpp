@@ -33,37 +33,39 @@ std::vector<std::uint8_t> dilate(const std::vector<std::uint8_t>& marked, int wi
 
 }  // namespace
 
-SeenFree::SeenFree(const ScanMassGrid& scan, const Pose2& pose, double stamp, double margin)
+SeenFree::SeenFree(const ScanMassGrid& scan, const Pose2& pose, double stamp, double margin, double small_margin)
   : geometry_(scan.geometry()), pose_(pose), cos_(std::cos(pose.yaw)), sin_(std::sin(pose.yaw)), stamp_(stamp)
 {
   const std::size_t n = geometry_.numCells();
   const float* f = scan.plane(FrameSG::kF);
   std::vector<std::uint8_t> not_free(n);
   for (std::size_t i = 0; i < n; ++i) not_free[i] = !(f[i] >= kSeenFreeMass);
-  const int r = std::max(0, static_cast<int>(std::ceil(margin / geometry_.resolution - kCellRounding)));
-  const std::vector<std::uint8_t> near = dilate(not_free, geometry_.width, geometry_.height, r);
-  clear_.resize(n);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    clear_[i] = !near[i];
-    clear_count_ += clear_[i];
-  }
+  auto clearAt = [&](double m) {
+    const int r = std::max(0, static_cast<int>(std::ceil(m / geometry_.resolution - kCellRounding)));
+    std::vector<std::uint8_t> out = dilate(not_free, geometry_.width, geometry_.height, r);
+    for (std::uint8_t& c : out) c = !c;
+    return out;
+  };
+  clear_ = clearAt(margin);
+  for (std::uint8_t c : clear_) clear_count_ += c;
+  if (small_margin >= 0.0) clear_small_ = clearAt(small_margin);
 }
 
-bool SeenFree::clear(Point2 p) const
+bool SeenFree::clear(Point2 p, bool small) const
 {
-  if (clear_.empty() || !std::isfinite(p.x) || !std::isfinite(p.y)) return false;
+  const std::vector<std::uint8_t>& cells = small && !clear_small_.empty() ? clear_small_ : clear_;
+  if (cells.empty() || !std::isfinite(p.x) || !std::isfinite(p.y)) return false;
   const double dx = p.x - pose_.x, dy = p.y - pose_.y;
   CellIndex c;
   if (!geometry_.worldToCell(Point2{ cos_ * dx + sin_ * dy, -sin_ * dx + cos_ * dy }, c)) return false;
-  return clear_[geometry_.index(c)] != 0;
+  return cells[geometry_.index(c)] != 0;
 }
 
-double SeenFree::clearShare(const std::vector<Point2>& points) const
+double SeenFree::clearShare(const std::vector<Point2>& points, bool small) const
 {
   if (points.empty()) return 0.0;
   std::size_t n = 0;
-  for (const Point2& p : points) n += clear(p);
+  for (const Point2& p : points) n += clear(p, small);
   return static_cast<double>(n) / static_cast<double>(points.size());
 }
 

@@ -66,6 +66,10 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_share", free_space_share, kMinShare, 1.0);
   requireInRange("tracker_free_space_margin", free_space_margin, 0.0, kMaxCellSize);
   requireInRange("tracker_free_space_time", free_space_time, kMinStep, kMaxFreeSpaceTime);
+  requireInRange("tracker_free_space_small_size", free_space_small_size, 0.0, max_object_width);
+  requireInRange("tracker_free_space_small_margin", free_space_small_margin, 0.0, free_space_margin);
+  requireInRange("tracker_free_space_small_min_extent", free_space_small_min_extent, 0.0, max_object_width);
+  requireInRange("tracker_free_space_small_max_speed", free_space_small_max_speed, 0.0, max_speed);
   requireInRange("tracker_evidence_hidden_length", evidence_hidden_length, 0.0, max_object_length);
   requireInRange("tracker_evidence_end_width", evidence_end_width, 0.0, max_object_width);
   requireInRange("tracker_evidence_small_size", evidence_small_size, 0.0, max_object_width);
@@ -371,6 +375,13 @@ void Tracker::decideMotion(Track& t, double stamp) const
     t.motion = TrackMotion::kUnknown;
 }
 
+bool Tracker::smallWalker(const Track& t) const
+{
+  const double small = params_.free_space_small_size, least = params_.free_space_small_min_extent;
+  return small > 0.0 && t.extent_length <= small && t.extent_width <= small && t.extent_length >= least &&
+         t.extent_width >= least && t.speed() <= params_.free_space_small_max_speed;
+}
+
 void Tracker::seeFreeSpace(Track& t, double stamp)
 {
   if (t.measurement < 0) return;
@@ -386,14 +397,15 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
   }
   if (!t.motion_seen && fastEnough(t))
   {
+    const bool small = smallWalker(t);
     // It left: the returns of one earlier sighting lie in the free space of this scan.
     const SeenFree& current = seen_free_.back();
     const bool left = std::any_of(t.sightings.begin(), t.sightings.end(), [&](const Sighting& past) {
-      return current.clearShare(past.points) >= params_.free_space_share;
+      return current.clearShare(past.points, small) >= params_.free_space_share;
     });
     // It came: its returns of this scan lie where some earlier scan saw free space.
     auto seenFreeBefore = [&](const Point2& q) {
-      return std::any_of(seen_free_.begin(), seen_free_.end() - 1, [&](const SeenFree& f) { return f.clear(q); });
+      return std::any_of(seen_free_.begin(), seen_free_.end() - 1, [&](const SeenFree& f) { return f.clear(q, small); });
     };
     const auto came = std::count_if(now.points.begin(), now.points.end(), seenFreeBefore);
     t.motion_seen = left || (!now.points.empty() && static_cast<double>(came) >=
@@ -429,7 +441,8 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
     seen_free_.erase(std::remove_if(seen_free_.begin(), seen_free_.end(),
                                     [&](const SeenFree& f) { return f.stamp() < oldest || f.stamp() >= stamp; }),
                      seen_free_.end());
-    seen_free_.emplace_back(*scan, pose, stamp, params_.free_space_margin);
+    seen_free_.emplace_back(*scan, pose, stamp, params_.free_space_margin,
+                            params_.free_space_small_size > 0.0 ? params_.free_space_small_margin : -1.0);
   }
   else
     seen_free_.clear();

@@ -452,6 +452,14 @@ TEST(SeenFree, ClearMeansEveryCellWithinTheMarginWasSeenFree)
   EXPECT_FALSE(own_cell.clear(map(2.25, 0.25)));
   EXPECT_TRUE(own_cell.clear(map(2.75, 0.25)));
   EXPECT_TRUE(own_cell.clear(map(-3.0, 9.75)));
+  // A second, smaller margin answers clear(p, true); the first answers clear(p) and counts the clear cells.
+  const SeenFree both(scan, pose, 3.0, 0.5, 0.0);
+  EXPECT_FALSE(both.clear(map(2.75, 0.25)));
+  EXPECT_TRUE(both.clear(map(2.75, 0.25), true));
+  EXPECT_FALSE(both.clear(map(2.25, 0.25), true)) << "the occupied cell";
+  EXPECT_DOUBLE_EQ(both.clearShare({ map(2.75, 0.25), map(2.25, 0.25) }, true), 0.5);
+  EXPECT_EQ(both.clearCells(), one_cell.clearCells());
+  EXPECT_FALSE(one_cell.clear(map(2.75, 0.25), true)) << "without a small margin, the margin";
   const SeenFree two_cells(scan, pose, 3.0, 0.6);
   EXPECT_FALSE(two_cells.clear(map(3.25, 0.25)));
   EXPECT_TRUE(two_cells.clear(map(3.75, 0.25)));
@@ -509,9 +517,62 @@ TEST(Tracker, FreeSpaceCheckTellsAMoverFromAWallFragmentThatSlidesAlong)
   EXPECT_EQ(no_scan.tracks()[0].motion, TrackMotion::kMoving);
 }
 
+namespace {
+
+/// The first scan from which the track of a small object walking along x at @p speed (from x = -2, returns at
+/// y = 5.1 … 5.4, every 0.1 m over 0.4 m along x, or a single row at y = 5.3 with @p sliver) is moving, -1 if never
+/// within 2 s. Free space is seen up to y = 5.5 only (beyond: a facade's shadow), so that every cell of the object
+/// lies next to space not seen.
+int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < 20; ++k)
+  {
+    const double x0 = -2.0 + speed * 0.1 * k;
+    std::vector<Point2> points;
+    for (int i = 0; i <= 12; ++i)
+    {
+      if (sliver)
+        points.push_back(Point2{ x0 + 0.4 * i / 12.0, 5.3 });
+      else if (i <= 4)
+        for (const double y : { 5.1, 5.2, 5.3, 5.4 }) points.push_back(Point2{ x0 + 0.1 * i, y });
+    }
+    const std::vector<float> xy = flatten(points);
+    const ScanMassGrid scan = scanGrid(xy, [](Point2 q) { return q.y < 5.5; });
+    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, &scan);
+    EXPECT_LE(tracker.tracks().size(), 1u);
+    if (!tracker.tracks().empty() && tracker.tracks()[0].motion == TrackMotion::kMoving) return k;
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(Tracker, SmallFreeSpaceLetsAPedestrianBesideAFacadeMove)
+{
+  TrackerParams p;
+  ASSERT_DOUBLE_EQ(p.free_space_small_margin, 0.0);
+  const int from = walkBesideAFacade(p, 1.4, false);
+  EXPECT_GE(from, 3);
+  EXPECT_LE(from, 10) << "a pedestrian at 1.4 m/s is moving within a second";
+  TrackerParams off = p;
+  off.free_space_small_size = 0.0;
+  EXPECT_EQ(walkBesideAFacade(off, 1.4, false), -1) << "the general margin never sees its cells free";
+  EXPECT_EQ(walkBesideAFacade(p, 2.5, false), -1) << "faster than a walk: the general margin";
+  EXPECT_EQ(walkBesideAFacade(p, 1.4, true), -1) << "a sliver thinner than the least extent: the general margin";
+  TrackerParams any_extent = p;
+  any_extent.free_space_small_min_extent = 0.0;
+  EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), 3) << "the sliver is moving without the least extent";
+}
+
 TEST(Tracker, FreeSpaceParametersAreValidatedByName)
 {
   expectRefusedByName({
+      { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = -0.1; } },
+      { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = 1e3; } },
+      { "tracker_free_space_small_margin", [](TrackerParams& p) { p.free_space_small_margin = 0.6; } },
+      { "tracker_free_space_small_min_extent", [](TrackerParams& p) { p.free_space_small_min_extent = -1.0; } },
+      { "tracker_free_space_small_max_speed", [](TrackerParams& p) { p.free_space_small_max_speed = std::nan(""); } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
       { "tracker_free_space_margin", [](TrackerParams& p) { p.free_space_margin = -0.1; } },

@@ -32,13 +32,16 @@ public:
    * @param pose    the vehicle pose in the map frame
    * @param stamp   the scan's time, s
    * @param margin  m: every cell this near (whole cells, rounded up) must be seen free too; ≥ 0
+   * @param small_margin  m: the margin of a second, tighter test (clear(p, true)); negative: none, clear(p, true) is
+   *                      clear(p)
    */
-  SeenFree(const ScanMassGrid& scan, const Pose2& pose, double stamp, double margin);
+  SeenFree(const ScanMassGrid& scan, const Pose2& pose, double stamp, double margin, double small_margin = -1.0);
 
-  /// True when the map-frame point @p p lies in a clear cell (false outside the grid or for a non-finite point).
-  bool clear(Point2 p) const;
-  /// Share of @p points that lie in clear cells (0 for none).
-  double clearShare(const std::vector<Point2>& points) const;
+  /// True when the map-frame point @p p lies in a clear cell (false outside the grid or for a non-finite point); with
+  /// @p small, clear at small_margin.
+  bool clear(Point2 p, bool small = false) const;
+  /// Share of @p points that lie in clear cells (0 for none); with @p small, at small_margin.
+  double clearShare(const std::vector<Point2>& points, bool small = false) const;
   double stamp() const { return stamp_; }
   /// Number of clear cells.
   std::size_t clearCells() const { return clear_count_; }
@@ -49,6 +52,7 @@ private:
   double cos_ = 1.0, sin_ = 0.0;
   double stamp_ = 0.0;
   std::vector<std::uint8_t> clear_;
+  std::vector<std::uint8_t> clear_small_;  ///< empty without a small margin
   std::size_t clear_count_ = 0;
 };
 

@@ -61,6 +61,15 @@ struct TrackerParams
   double free_space_share = 0.3;     ///< share of a sighting's returns that must lie in free space, (0, 1]
   double free_space_margin = 0.5;    ///< m: a point is in free space when every ScanGrid cell this near was seen free
   double free_space_time = 1.0;      ///< s: how far back sightings and scans are compared
+  /// Step "small free space": a pedestrian walks beside facades, parked cars and poles, whose cells lie within
+  /// free_space_margin of it, so that free space never shows where it left or came. A track at most
+  /// free_space_small_size long and wide (0: off), at least free_space_small_min_extent on both axes (a sliver of a
+  /// wall seen edge-on is thinner) and no faster than free_space_small_max_speed (a walk) is checked with
+  /// free_space_small_margin instead.
+  double free_space_small_size = 1.0;        ///< m
+  double free_space_small_margin = 0.0;      ///< m, [0, free_space_margin]
+  double free_space_small_min_extent = 0.1;  ///< m
+  double free_space_small_max_speed = 2.0;   ///< m/s
   /// Step "heading box": a track's box keeps the axes of its first cluster, so an object that turns is seen askew in
   /// them: its box grows (a cyclist's to 1.7 × 1.6 m) and the point followed slides off the object until the gate
   /// loses it. A moving track's box no longer than heading_box_max_length turns to its heading, from the cluster of
@@ -132,6 +141,10 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_free_space_share", p.free_space_share, { "", "share of a sighting's returns that must lie in free space" });
   get("tracker_free_space_margin", p.free_space_margin, { "m", "a point is in free space when every ScanGrid cell this near (whole cells) was seen free" });
   get("tracker_free_space_time", p.free_space_time, { "s", "how far back the free-space check compares sightings and scans" });
+  get("tracker_free_space_small_size", p.free_space_small_size, { "m", "step small free space: a track at most this long and wide is checked with tracker_free_space_small_margin; 0: off" });
+  get("tracker_free_space_small_margin", p.free_space_small_margin, { "m", "the free-space margin of a small track (step small free space)" });
+  get("tracker_free_space_small_min_extent", p.free_space_small_min_extent, { "m", "… when at least this long and wide (a sliver of a wall is thinner)" });
+  get("tracker_free_space_small_max_speed", p.free_space_small_max_speed, { "m/s", "… and no faster than this (a walk)" });
   get("tracker_heading_box", p.heading_box, { "", "step heading box: a short moving track's box turns to its heading once askew" });
   get("tracker_heading_box_angle", p.heading_box_angle, { "deg", "the box turns when its axes are this far from the track's heading" });
   get("tracker_heading_box_max_length", p.heading_box_max_length, { "m", "only boxes no longer than this turn to the heading" });
@@ -312,6 +325,8 @@ private:
   /// Step free-space check: records @p t's sighting of this scan and tells whether free space shows its motion.
   void seeFreeSpace(Track& t, double stamp);
   bool fastEnough(const Track& t) const;
+  /// Step small free space: @p t is checked with free_space_small_margin.
+  bool smallWalker(const Track& t) const;
 
   TrackerParams params_;
   std::vector<Track> tracks_;
