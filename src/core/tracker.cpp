@@ -55,6 +55,7 @@ void TrackerParams::validate() const
   requirePositive("tracker_gate", gate);
   requirePositive("tracker_max_gate_distance", max_gate_distance);
   requireInRange("tracker_confirm_hits", confirm_hits, 1, 1000);
+  requireInRange("tracker_fragment_margin", fragment_margin, 0.0, max_object_length);
   requireInRange("tracker_max_coast_time", max_coast_time, 0.0, 60.0);
   requireInRange("tracker_moving_speed", moving_speed, 0.0, 100.0);
   requireInRange("tracker_motion_sigmas", motion_sigmas, 0.0, 10.0);
@@ -576,10 +577,32 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     kept.push_back(std::move(t));
   }
   const double v2 = params_.initial_speed_sigma * params_.initial_speed_sigma;
+  const std::size_t seen_tracks = kept.size();
+  // Step fragments: the box of a moving track seen this scan, grown by the margin, holds the centroid of @p z.
+  auto fragment = [&](const Measurement& z) {
+    if (!params_.fragments) return false;
+    const double grow = params_.fragment_margin;
+    for (std::size_t j = 0; j < seen_tracks; ++j)
+    {
+      const Track& o = kept[j];
+      if (o.motion != TrackMotion::kMoving || o.last_hit < stamp) continue;
+      const double c = std::cos(o.extent_yaw), sn = std::sin(o.extent_yaw);
+      const double dx = z.centroid.x - o.x(0), dy = z.centroid.y - o.x(1);
+      if (std::abs(dx * c + dy * sn) <= 0.5 * o.extent_length + grow &&
+          std::abs(-dx * sn + dy * c) <= 0.5 * o.extent_width + grow)
+        return true;
+    }
+    return false;
+  };
   for (std::size_t m = 0; m < measurements_.size(); ++m)
   {
     if (used[m]) continue;
     const Measurement& z = measurements_[m];
+    if (fragment(z))
+    {
+      ++counts_.fragments;
+      continue;
+    }
     Track t;
     t.id = next_id_++;
     // The middle of the cluster's box, the point referencePoint() follows.

@@ -729,6 +729,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("tracker resets in window", tracker_resets_window_.count(now));
     status.add("tracker resets", c.resets);
     status.add("tracks deleted (non-finite or too fast)", c.rejected_tracks);
+    status.add("clusters not tracked (fragments of a moving track)", c.fragments);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }
 }

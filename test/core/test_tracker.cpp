@@ -565,9 +565,57 @@ TEST(Tracker, SmallFreeSpaceLetsAPedestrianBesideAFacadeMove)
   EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), 3) << "the sliver is moving without the least extent";
 }
 
+namespace {
+
+/// A 4 × 2 m car driving along y = 0 at @p speed (m/s) for 12 scans, seen whole from the origin, and from scan 6 on
+/// a second cluster (a 0.3 × 0.3 m block of returns) riding along with it @p offset m beside its side (its centre at
+/// y = 1 + offset). Returns the tracker after the last scan.
+Tracker carWithACompanion(const TrackerParams& params, double speed, double offset)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < 12; ++k)
+  {
+    const double x = 10.0 + speed * 0.1 * k;
+    std::vector<Point2> points = boxOutline(x, 0.0, 0.0, 4.0, 2.0);
+    if (k >= 6)
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) points.push_back(Point2{ x - 0.15 + 0.1 * i, 1.0 + offset - 0.15 + 0.1 * j });
+    const std::vector<float> xy = flatten(points);
+    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  }
+  return tracker;
+}
+
+}  // namespace
+
+TEST(Tracker, FragmentsOfAMovingTrackStartNoTrack)
+{
+  TrackerParams p;
+  ASSERT_DOUBLE_EQ(p.fragment_margin, 1.0);
+  // 0.8 m beside the moving car's side (its box grown by 1 m): a fragment, no track of its own, counted.
+  const Tracker beside = carWithACompanion(p, 8.0, 0.8);
+  ASSERT_EQ(beside.tracks().size(), 1u);
+  EXPECT_EQ(beside.tracks()[0].motion, TrackMotion::kMoving);
+  EXPECT_EQ(beside.counts().fragments, 6u) << "one per scan from scan 6";
+  EXPECT_EQ(beside.counts().tracks_created, 1u);
+  // The step off: a second track.
+  TrackerParams off = p;
+  off.fragments = false;
+  const Tracker without = carWithACompanion(off, 8.0, 0.8);
+  EXPECT_EQ(without.tracks().size(), 2u);
+  EXPECT_EQ(without.counts().fragments, 0u);
+  // 1.4 m beside it (beyond the margin), or beside a parked car (no moving track): a track of its own.
+  EXPECT_EQ(carWithACompanion(p, 8.0, 1.4).tracks().size(), 2u);
+  const Tracker parked = carWithACompanion(p, 0.0, 0.8);
+  EXPECT_EQ(parked.tracks().size(), 2u);
+  EXPECT_EQ(parked.counts().fragments, 0u);
+}
+
 TEST(Tracker, FreeSpaceParametersAreValidatedByName)
 {
   expectRefusedByName({
+      { "tracker_fragment_margin", [](TrackerParams& p) { p.fragment_margin = -0.1; } },
+      { "tracker_fragment_margin", [](TrackerParams& p) { p.fragment_margin = std::nan(""); } },
       { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = -0.1; } },
       { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = 1e3; } },
       { "tracker_free_space_small_margin", [](TrackerParams& p) { p.free_space_small_margin = 0.6; } },

@@ -46,6 +46,12 @@ struct TrackerParams
   double gate = 13.8;                ///< Mahalanobis² of an association (χ² with 2 dof: 13.8 is 99.9 %)
   double max_gate_distance = 3.0;    ///< m: no association farther than this, whatever the covariance
   int confirm_hits = 3;              ///< consecutive associations that confirm a tentative track
+  /// Step "fragments": an object seen in several clusters (a bus's side behind its face, a van past an occluder, the
+  /// sparse returns of a far car) gets one track per cluster, and every track but one is a false moving object. A
+  /// cluster no track takes whose centroid lies in the box of a moving track seen this scan, grown by
+  /// fragment_margin on every side, starts no track (and is counted).
+  bool fragments = true;
+  double fragment_margin = 1.0;      ///< m
   double max_coast_time = 0.5;       ///< s without an association before a confirmed track is deleted
   double moving_speed = 0.5;         ///< m/s: moving when speed − motion_sigmas · σ(speed) is above this
   double motion_sigmas = 1.5;        ///< how many standard deviations the speed must clear
@@ -130,6 +136,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_gate", p.gate, { "", "Mahalanobis² gate of an association (χ², 2 dof: 13.8 is 99.9 %)" });
   get("tracker_max_gate_distance", p.max_gate_distance, { "m", "no association farther than this, whatever the covariance" });
   get("tracker_confirm_hits", p.confirm_hits, { "scans", "consecutive associations that confirm a tentative track" });
+  get("tracker_fragments", p.fragments, { "", "step fragments: a cluster in the box of a moving track seen this scan (grown by tracker_fragment_margin) starts no track" });
+  get("tracker_fragment_margin", p.fragment_margin, { "m", "how far beyond a moving track's box a cluster is a fragment of it (step fragments)" });
   get("tracker_max_coast_time", p.max_coast_time, { "s", "time without an association before a confirmed track is deleted" });
   get("tracker_moving_speed", p.moving_speed, { "m/s", "moving when speed − motion_sigmas·σ(speed) is above this" });
   get("tracker_motion_sigmas", p.motion_sigmas, { "", "standard deviations the speed must clear to call a motion state" });
@@ -275,6 +283,7 @@ struct TrackerCounts
   std::uint64_t tracks_deleted = 0;
   std::uint64_t resets = 0;             ///< every track dropped: a pose or time jump
   std::uint64_t rejected_tracks = 0;    ///< deleted for a non-finite state or an implausible speed
+  std::uint64_t fragments = 0;          ///< clusters that started no track: fragments of a moving track (step fragments)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
