@@ -40,15 +40,19 @@ SeenFree::SeenFree(const ScanMassGrid& scan, const Pose2& pose, double stamp, do
   const float* f = scan.plane(FrameSG::kF);
   std::vector<std::uint8_t> not_free(n);
   for (std::size_t i = 0; i < n; ++i) not_free[i] = !(f[i] >= kSeenFreeMass);
-  auto clearAt = [&](double m) {
-    const int r = std::max(0, static_cast<int>(std::ceil(m / geometry_.resolution - kCellRounding)));
+  auto cells = [&](double m) {
+    return std::max(0, static_cast<int>(std::ceil(m / geometry_.resolution - kCellRounding)));
+  };
+  auto clearAt = [&](int r) {
     std::vector<std::uint8_t> out = dilate(not_free, geometry_.width, geometry_.height, r);
     for (std::uint8_t& c : out) c = !c;
     return out;
   };
-  clear_ = clearAt(margin);
+  const int r = cells(margin);
+  clear_ = clearAt(r);
   for (std::uint8_t c : clear_) clear_count_ += c;
-  if (small_margin >= 0.0) clear_small_ = clearAt(small_margin);
+  // The same whole cells as the margin: clear(p, true) falls back to clear_.
+  if (small_margin >= 0.0 && cells(small_margin) != r) clear_small_ = clearAt(cells(small_margin));
 }
 
 bool SeenFree::clear(Point2 p, bool small) const

@@ -930,10 +930,10 @@ TEST(Tracker, SmallBoxCoversThePedestrianBehindItsReturns)
   off.evidence_small_box = false;
   const std::vector<std::pair<double, double>> returns_only{ { 11.25, -0.25 }, { 11.25, 0.25 } };
   EXPECT_EQ(centres(pedestrianEvidence(off, g, 1.0), g), returns_only);
-  // Not for a track larger than evidence_small_size (a cyclist's 1.2 m wide side: not a small mover).
-  TrackerParams narrow = p;
-  narrow.evidence_small_size = 0.5;
-  EXPECT_EQ(centres(pedestrianEvidence(narrow, g, 1.0), g), returns_only);
+  // Not for a track larger than evidence_small_size (here 0.5 m, below the 0.6 m width): no small mover.
+  TrackerParams half_metre = p;
+  half_metre.evidence_small_size = 0.5;
+  EXPECT_EQ(centres(pedestrianEvidence(half_metre, g, 1.0), g), returns_only);
 }
 
 TEST(Tracker, TrackEvidenceSizeParametersAreValidatedByName)
