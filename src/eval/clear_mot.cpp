@@ -1,7 +1,5 @@
 #include "map_aided_fusion/eval/clear_mot.hpp"
 
-#include <cstdio>
-#include <cstdlib>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -100,7 +98,6 @@ void ClearMot::addFrame(const std::vector<MotObject>& objects, const std::vector
     const int j = object_to_hyp[i];
     if (j < 0)
     {
-      if (std::getenv("MAF_DBG")) std::fprintf(stderr, "MISS obj=%u op=(%.1f,%.1f)\n", o.id, o.position.x, o.position.y);
       ++misses_;
       if (h.tracked_now) ++h.pending_gaps;
       h.tracked_now = false;
@@ -124,8 +121,6 @@ void ClearMot::addFrame(const std::vector<MotObject>& objects, const std::vector
     now[o.id] = hyp.id;
     if (o.has_velocity && hyp.has_velocity)
       velocity_errors_.push_back(distance(o.velocity, hyp.velocity));
-    if (std::getenv("MAF_DBG") && o.has_velocity && hyp.has_velocity)
-      std::fprintf(stderr, "VE obj=%u hyp=%u err=%.2f ov=(%.2f,%.2f) hv=(%.2f,%.2f) op=(%.1f,%.1f) hp=(%.1f,%.1f)\n", o.id, hyp.id, distance(o.velocity, hyp.velocity), o.velocity.x, o.velocity.y, hyp.velocity.x, hyp.velocity.y, o.position.x, o.position.y, hyp.position.x, hyp.position.y);
   }
   // An object absent from this frame is not tracked in it: a later pair after the gap resumes it.
   for (auto& [id, h] : history_)
@@ -135,9 +130,6 @@ void ClearMot::addFrame(const std::vector<MotObject>& objects, const std::vector
       h.tracked_now = false;
     }
   for (char u : hyp_used) false_positives_ += u == 0;
-  if (std::getenv("MAF_DBG"))
-    for (std::size_t j = 0; j < hyp_used.size(); ++j)
-      if (hyp_used[j] == 0) std::fprintf(stderr, "FP hyp=%u hp=(%.1f,%.1f)\n", hypotheses[j].id, hypotheses[j].position.x, hypotheses[j].position.y);
   previous_ = std::move(now);
 }
 
