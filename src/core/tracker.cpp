@@ -67,6 +67,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_share", free_space_share, kMinShare, 1.0);
   requireInRange("tracker_free_space_margin", free_space_margin, 0.0, kMaxCellSize);
   requireInRange("tracker_free_space_time", free_space_time, kMinStep, kMaxFreeSpaceTime);
+  requireInRange("tracker_free_space_motion_sigmas", free_space_motion_sigmas, 0.0, 10.0);
   requireInRange("tracker_free_space_small_size", free_space_small_size, 0.0, max_object_width);
   requireInRange("tracker_free_space_small_margin", free_space_small_margin, 0.0, free_space_margin);
   requireInRange("tracker_free_space_small_min_extent", free_space_small_min_extent, 0.0, max_object_width);
@@ -349,9 +350,9 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
     t.state = TrackState::kConfirmed;
 }
 
-bool Tracker::fastEnough(const Track& t) const
+bool Tracker::fastEnough(const Track& t, double sigmas) const
 {
-  return t.speed() - params_.motion_sigmas * t.speedSigma() > params_.moving_speed;
+  return t.speed() - sigmas * t.speedSigma() > params_.moving_speed;
 }
 
 void Tracker::decideMotion(Track& t, double stamp) const
@@ -368,7 +369,7 @@ void Tracker::decideMotion(Track& t, double stamp) const
   }
   else
     t.still_since = -1.0;
-  if (fastEnough(t) && (!free_now_ || t.motion_seen))
+  if (fastEnough(t, free_now_ ? params_.free_space_motion_sigmas : params_.motion_sigmas) && (!free_now_ || t.motion_seen))
     t.motion = TrackMotion::kMoving;
   else if (t.still_since >= 0.0 && stamp - t.still_since >= params_.stopped_time - kMinStep)
     t.motion = TrackMotion::kStopped;
@@ -396,7 +397,7 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     const int i = idx[k * idx.size() / n];
     if (i >= 0 && i < static_cast<int>(map_points_.size())) now.points.push_back(map_points_[i]);
   }
-  if (!t.motion_seen && fastEnough(t))
+  if (!t.motion_seen && fastEnough(t, params_.free_space_motion_sigmas))
   {
     const bool small = smallWalker(t);
     // It left: the returns of one earlier sighting lie in the free space of this scan.

@@ -504,17 +504,68 @@ TEST(Tracker, FreeSpaceCheckTellsAMoverFromAWallFragmentThatSlidesAlong)
   bool wall = false;
   EXPECT_EQ(run(true, car_from, wall), 2u);
   EXPECT_FALSE(wall) << "a sliding view of a wall is not a mover";
-  EXPECT_GE(car_from, 3u);
+  EXPECT_GE(car_from, static_cast<std::uint32_t>(TrackerParams{}.confirm_hits - 1)) << "tentative before";
   EXPECT_LE(car_from, 6u) << "the car is moving within half a second";
   std::uint32_t car_without = 0;
   EXPECT_EQ(run(false, car_without, wall), 2u);
   EXPECT_TRUE(wall) << "without the check, the velocity alone calls the wall fragment moving";
-  EXPECT_LE(car_without, car_from);
+  EXPECT_LE(car_without, 6u);
   // Without a ScanGrid (update(stamp, measurements) or no scan given), the motion comes from the velocity alone.
   Tracker no_scan;
   for (int k = 0; k <= 8; ++k) no_scan.update(0.1 * k, { at(8.0 * 0.1 * k, 0.0) });
   ASSERT_EQ(no_scan.tracks().size(), 1u);
   EXPECT_EQ(no_scan.tracks()[0].motion, TrackMotion::kMoving);
+}
+
+namespace {
+
+/// The first scan from which the track of a 4 × 2 m car driving along y = 5 at @p speed over road seen free is
+/// moving (-1 if never within 2 s), with a ScanGrid (the free-space check runs) or without one (velocity alone); the
+/// track's speed and its standard deviation at that scan.
+int carMovingFrom(const TrackerParams& params, double speed, bool with_scan, double& s, double& sigma)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < 20; ++k)
+  {
+    const std::vector<float> xy = flatten(boxOutline(-10.0 + speed * 0.1 * k, 5.0, 0.0, 4.0, 2.0));
+    const ScanMassGrid scan = scanGrid(xy, [](Point2 q) { return q.y < 15.0; });
+    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, with_scan ? &scan : nullptr);
+    EXPECT_LE(tracker.tracks().size(), 1u);
+    if (!tracker.tracks().empty() && tracker.tracks()[0].motion == TrackMotion::kMoving)
+    {
+      s = tracker.tracks()[0].speed();
+      sigma = tracker.tracks()[0].speedSigma();
+      return k;
+    }
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(Tracker, FreeSpaceMotionSigmasApplyOnlyWhileTheCheckRuns)
+{
+  TrackerParams p;
+  ASSERT_DOUBLE_EQ(p.free_space_motion_sigmas, 0.5);
+  ASSERT_DOUBLE_EQ(p.motion_sigmas, 1.5);
+  double s = 0.0, sigma = 0.0;
+  const int relaxed = carMovingFrom(p, 1.5, true, s, sigma);
+  ASSERT_GE(relaxed, 0);
+  EXPECT_GT(s - p.free_space_motion_sigmas * sigma, p.moving_speed);
+  EXPECT_LE(s - p.motion_sigmas * sigma, p.moving_speed) << "the scene must tell the two thresholds apart";
+  TrackerParams strict = p;
+  strict.free_space_motion_sigmas = p.motion_sigmas;
+  const int strict_from = carMovingFrom(strict, 1.5, true, s, sigma);
+  EXPECT_GT(strict_from, relaxed) << "motion_sigmas standard deviations take longer";
+  EXPECT_GT(s - p.motion_sigmas * sigma, p.moving_speed);
+  // Without a ScanGrid the velocity alone decides, with motion_sigmas whatever free_space_motion_sigmas says.
+  TrackerParams zero = p;
+  zero.free_space_motion_sigmas = 0.0;
+  double s0 = 0.0, sigma0 = 0.0;
+  const int alone = carMovingFrom(p, 1.5, false, s, sigma);
+  ASSERT_GE(alone, 0);
+  EXPECT_EQ(carMovingFrom(zero, 1.5, false, s0, sigma0), alone);
+  EXPECT_GT(s - p.motion_sigmas * sigma, p.moving_speed);
 }
 
 namespace {
@@ -553,16 +604,18 @@ TEST(Tracker, SmallFreeSpaceLetsAPedestrianBesideAFacadeMove)
   TrackerParams p;
   ASSERT_DOUBLE_EQ(p.free_space_small_margin, 0.0);
   const int from = walkBesideAFacade(p, 1.4, false);
-  EXPECT_GE(from, 3);
+  EXPECT_GE(from, p.confirm_hits - 1) << "tentative before";
   EXPECT_LE(from, 10) << "a pedestrian at 1.4 m/s is moving within a second";
   TrackerParams off = p;
   off.free_space_small_size = 0.0;
   EXPECT_EQ(walkBesideAFacade(off, 1.4, false), -1) << "the general margin never sees its cells free";
-  EXPECT_EQ(walkBesideAFacade(p, 2.5, false), -1) << "faster than a walk: the general margin";
+  // 3 m/s: at 2.5 m/s the speed estimated from the first three scans is still under the 2 m/s cap when the track is
+  // confirmed, and that first check passes.
+  EXPECT_EQ(walkBesideAFacade(p, 3.0, false), -1) << "faster than a walk: the general margin";
   EXPECT_EQ(walkBesideAFacade(p, 1.4, true), -1) << "a sliver thinner than the least extent: the general margin";
   TrackerParams any_extent = p;
   any_extent.free_space_small_min_extent = 0.0;
-  EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), 3) << "the sliver is moving without the least extent";
+  EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), p.confirm_hits - 1) << "the sliver is moving without the least extent";
 }
 
 namespace {
@@ -625,7 +678,9 @@ TEST(Tracker, FreeSpaceParametersAreValidatedByName)
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
       { "tracker_free_space_margin", [](TrackerParams& p) { p.free_space_margin = -0.1; } },
       { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = 0.0; } },
-      { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } } });
+      { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } },
+      { "tracker_free_space_motion_sigmas", [](TrackerParams& p) { p.free_space_motion_sigmas = -0.5; } },
+      { "tracker_free_space_motion_sigmas", [](TrackerParams& p) { p.free_space_motion_sigmas = 11.0; } } });
 }
 
 namespace {

@@ -67,6 +67,9 @@ struct TrackerParams
   double free_space_share = 0.3;     ///< share of a sighting's returns that must lie in free space, (0, 1]
   double free_space_margin = 0.5;    ///< m: a point is in free space when every ScanGrid cell this near was seen free
   double free_space_time = 1.0;      ///< s: how far back sightings and scans are compared
+  /// While the check runs, free space has shown the motion too, so the speed need clear moving_speed by this many
+  /// standard deviations only, instead of motion_sigmas (which still decides without a ScanGrid).
+  double free_space_motion_sigmas = 0.5;
   /// Step "small free space": a pedestrian walks beside facades, parked cars and poles, whose cells lie within
   /// free_space_margin of it, so that free space never shows where it left or came. A track at most
   /// free_space_small_size long and wide (0: off), at least free_space_small_min_extent on both axes (a sliver of a
@@ -149,6 +152,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_free_space_share", p.free_space_share, { "", "share of a sighting's returns that must lie in free space" });
   get("tracker_free_space_margin", p.free_space_margin, { "m", "a point is in free space when every ScanGrid cell this near (whole cells) was seen free" });
   get("tracker_free_space_time", p.free_space_time, { "s", "how far back the free-space check compares sightings and scans" });
+  get("tracker_free_space_motion_sigmas", p.free_space_motion_sigmas, { "", "standard deviations the speed must clear to be moving while the free-space check runs" });
   get("tracker_free_space_small_size", p.free_space_small_size, { "m", "step small free space: a track at most this long and wide is checked with tracker_free_space_small_margin; 0: off" });
   get("tracker_free_space_small_margin", p.free_space_small_margin, { "m", "the free-space margin of a small track (step small free space)" });
   get("tracker_free_space_small_min_extent", p.free_space_small_min_extent, { "m", "… when at least this long and wide (a sliver of a wall is thinner)" });
@@ -333,7 +337,8 @@ private:
   void decideMotion(Track& t, double stamp) const;
   /// Step free-space check: records @p t's sighting of this scan and tells whether free space shows its motion.
   void seeFreeSpace(Track& t, double stamp);
-  bool fastEnough(const Track& t) const;
+  /// speed − sigmas · σ(speed) above moving_speed.
+  bool fastEnough(const Track& t, double sigmas) const;
   /// Step small free space: @p t is checked with free_space_small_margin.
   bool smallWalker(const Track& t) const;
 
