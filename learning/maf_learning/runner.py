@@ -51,10 +51,11 @@ class Drive:
         self.bag = os.path.join(self.dir, f"{self.name}-{digest}.bag")
 
     def prepare(self, simulate, timeout=900):
-        """Simulates the bag unless a bag of the same scenario exists (written whole: .partial renamed)."""
+        """Simulates the bag unless a bag of the same scenario, newer than the simulator, exists (written whole:
+        .partial renamed)."""
         os.makedirs(self.dir, exist_ok=True)
         drv.write_scenario(self.scenario, self.yaml)
-        if os.path.isfile(self.bag):
+        if os.path.isfile(self.bag) and os.path.getmtime(self.bag) >= os.path.getmtime(simulate):
             return False
         partial = self.bag + ".partial.bag"
         try:

@@ -326,13 +326,15 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& base_dir
   }
   if (const YAML::Node g = root["ground_truth"])
   {
-    requireKnownKeys(g, "ground_truth.", { "size_x", "size_y", "resolution", "stop_speed", "include_no_return_rays" });
+    requireKnownKeys(g, "ground_truth.",
+                     { "size_x", "size_y", "resolution", "stop_speed", "include_no_return_rays", "object_needs_hit" });
     GroundTruthParams& p = sc.ground_truth;
     p.size_x = get<double>(g, "size_x", "ground_truth.", p.size_x);
     p.size_y = get<double>(g, "size_y", "ground_truth.", p.size_y);
     p.resolution = get<double>(g, "resolution", "ground_truth.", p.resolution);
     p.stop_speed = get<double>(g, "stop_speed", "ground_truth.", p.stop_speed);
     p.include_no_return_rays = get<bool>(g, "include_no_return_rays", "ground_truth.", p.include_no_return_rays);
+    p.object_needs_hit = get<bool>(g, "object_needs_hit", "ground_truth.", p.object_needs_hit);
   }
   if (const YAML::Node s = root["scene"])
   {

@@ -317,6 +317,7 @@ void Simulator::scan(int k, ScanFrame& out)
   out.truth_geometry = static_raster_->window(out.ego.x, out.ego.y, gt.size_x, gt.size_y);
   static_raster_->classes(out.truth_geometry, scene_->objects(), out.truth_classes);
   observed_.assign(out.truth_geometry.numCells(), 0);
+  object_hit_.assign(scene_->objects().size(), 0);
 
   Rng rng(scenario_.seed * 0x9E3779B97F4A7C15ULL ^ (static_cast<std::uint64_t>(k) + 1) * 0xD1B54A32D192ED03ULL);
   const int beams = lidar.numBeams();
@@ -363,6 +364,7 @@ void Simulator::scan(int k, ScanFrame& out)
         continue;
       }
       s_obs = std::max(s_obs, h.s);
+      if (h.solid >= Scene::kObjectBase) object_hit_[static_cast<std::size_t>(h.solid - Scene::kObjectBase)] = 1;
       if (rng.uniform() < lidar.dropout_probability)
       {
         ++out.dropped;
@@ -403,6 +405,15 @@ void Simulator::scan(int k, ScanFrame& out)
     if (s_obs >= 0.0)
       traverseCells(out.truth_geometry, core::Point2{ origin.x, origin.y }, std::cos(az_w), std::sin(az_w), s_obs,
                     [&](std::size_t c) { observed_[c] = 1; });
+  }
+  if (gt.object_needs_hit)
+  {
+    constexpr std::int8_t kNoFootprint = std::numeric_limits<std::int8_t>::min();
+    hidden_cells_.assign(observed_.size(), kNoFootprint);
+    for (std::size_t j = 0; j < object_hit_.size(); ++j)
+      if (!object_hit_[j]) rasterizeObject(scene_->objects()[j], out.truth_geometry, hidden_cells_);
+    for (std::size_t c = 0; c < observed_.size(); ++c)
+      if (hidden_cells_[c] != kNoFootprint) observed_[c] = 0;
   }
   for (std::size_t c = 0; c < observed_.size(); ++c)
     if (!observed_[c]) out.truth_classes[c] = static_cast<std::int8_t>(core::CellClass::kUnknown);

@@ -134,6 +134,34 @@ TEST(SimSimulator, RaysWithoutReturnCanCountAsObserved)
   EXPECT_EQ(classAt(f, 10.25, 0.25), 1);
 }
 
+TEST(SimSimulator, AnObjectNoRayHitIsNotObserved)
+{
+  // A walker 0.5 m tall at (-25, 0): the level beam (1 m high) passes over it to the backstop D at x = -35.
+  Scenario sc = smallScenario();
+  ObjectSpec walker = object(4, "pedestrian", { { -25.0, 0.0 }, { -25.0, 30.0 } }, 1.0);
+  walker.height = 0.5;
+  sc.objects.push_back(walker);
+  for (const bool needs_hit : { true, false })
+  {
+    sc.ground_truth.object_needs_hit = needs_hit;
+    Simulator sim(sc, smallMap());
+    ScanFrame f;
+    sim.scan(0, f);
+    EXPECT_EQ(classAt(f, -35.25, 0.25), 1) << "the ray passes over the walker to D";
+    EXPECT_EQ(classAt(f, -24.75, 0.25), needs_hit ? -1 : 4) << "the walker's cell";
+    EXPECT_EQ(classAt(f, -22.25, 0.25), 0) << "free ground in front of it stays observed";
+    EXPECT_EQ(classAt(f, 0.25, -7.25), 3) << "the parked car is hit: observed";
+    EXPECT_EQ(classAt(f, 7.9, 7.9), 2) << "the pole is hit: observed";
+  }
+  // Taller, it is hit and observed.
+  sc.objects.back().height = 1.75;
+  sc.ground_truth.object_needs_hit = true;
+  Simulator sim(sc, smallMap());
+  ScanFrame f;
+  sim.scan(0, f);
+  EXPECT_EQ(classAt(f, -24.75, 0.25), 4);
+}
+
 TEST(SimSimulator, PointsAreExactWithoutNoise)
 {
   Simulator sim(smallScenario(), smallMap());
@@ -308,7 +336,7 @@ map_origin: [49.415, 2.823, 40]
 duration: 12.5
 seed: 99
 lidar: {preset: ibeo4, dropout_probability: 0.0}
-ground_truth: {size_x: 40, size_y: 30, resolution: 0.25}
+ground_truth: {size_x: 40, size_y: 30, resolution: 0.25, object_needs_hit: false}
 ego:
   route: [[0, 0], [50, 0]]
   speed: 8
@@ -334,6 +362,7 @@ objects:
   EXPECT_EQ(sc.lidar.numAzimuths(), 221);
   EXPECT_DOUBLE_EQ(sc.lidar.dropout_probability, 0.0);
   EXPECT_DOUBLE_EQ(sc.ground_truth.resolution, 0.25);
+  EXPECT_FALSE(sc.ground_truth.object_needs_hit);
   ASSERT_EQ(sc.ego.motion.stops.size(), 1u);
   EXPECT_NEAR(sc.ego.motion.stops[0].s, 20.0, 1e-9);
   ASSERT_EQ(sc.map_errors.unmapped.size(), 1u);

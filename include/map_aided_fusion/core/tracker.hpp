@@ -41,7 +41,7 @@ struct TrackerParams
   double max_object_width = 4.0;     ///< m: a wider cluster is no object
   double measurement_sigma = 0.15;   ///< m, standard deviation of a compact cluster's centroid
   double extent_sigma = 0.1;         ///< m of standard deviation per metre of the cluster's extent on that axis
-  double acceleration_sigma = 1.0;   ///< m/s², white-noise acceleration of the constant-velocity model
+  double acceleration_sigma = 2.0;   ///< m/s², white-noise acceleration of the constant-velocity model
   double initial_speed_sigma = 5.0;  ///< m/s, velocity standard deviation of a new track
   double gate = 13.8;                ///< Mahalanobis² of an association (χ² with 2 dof: 13.8 is 99.9 %)
   double max_gate_distance = 3.0;    ///< m: no association farther than this, whatever the covariance

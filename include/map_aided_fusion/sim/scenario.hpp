@@ -115,6 +115,9 @@ struct GroundTruthParams
   double stop_speed = 0.1;   ///< m/s, a movable object slower than this is stopped (S)
   /// Count the cells traversed by rays without any return (up to their max range) as observed.
   bool include_no_return_rays = false;
+  /// An object's footprint is observed only in a scan in which some ray hit the object (its cells are -1 otherwise):
+  /// the rays that pass over a pedestrian hidden behind a parked car, to a facade behind, do not see it.
+  bool object_needs_hit = true;
   /// @throws core::ParameterError naming the parameter
   void validate() const;
 };

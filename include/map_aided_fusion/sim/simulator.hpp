@@ -66,7 +66,8 @@ struct ScanFrame
    * to and including the cell of the ray's noise-free hit (returns lost to dropout still count; rays without
    * any hit count up to their max range only with ground_truth.include_no_return_rays). Classes: mapped
    * buildings C, buildings missing from the map N, objects by their class (the larger code wins where
-   * footprints share a cell), the rest F; a cell belongs to a footprint when they overlap.
+   * footprints share a cell), the rest F; a cell belongs to a footprint when they overlap. With
+   * ground_truth.object_needs_hit (the default), the footprint of an object that no ray of this scan hit is -1.
    */
   std::vector<std::int8_t> truth_classes;
   std::vector<ObjectTruth> objects;        ///< objects present at this instant
@@ -132,6 +133,8 @@ private:
   std::vector<double> slopes_, max_s_, cos_e_, sin_e_, tilted_slopes_;
   std::vector<BeamHit> hits_;
   std::vector<std::uint8_t> observed_;
+  std::vector<std::uint8_t> object_hit_;     ///< per object of scene_->objects(): some ray of this scan hit it
+  std::vector<std::int8_t> hidden_cells_;    ///< footprints of the objects no ray hit
   std::vector<WorldObject> solids_;
   std::vector<Point2> walk_;  ///< random walk of the localisation error, one sample per tf period
 };
