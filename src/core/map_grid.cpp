@@ -25,7 +25,8 @@ constexpr std::size_t kPriorRows = 32;         // rows per chunk of the prior wi
 constexpr std::size_t kSpreadChunk = 256;      // cells per chunk of motion spreading's cell pass
 constexpr std::size_t kSpreadAhead = 4;        // cells ahead whose blocks that pass prefetches
 constexpr std::size_t kFloatsPerLine = 16;     // floats per cache line
-constexpr std::size_t kShiftRows = 16;         // window rows per chunk of a shift's column move
+constexpr std::size_t kShiftBandRows = 32;     // least window rows per band of a shift (moved in parallel)
+constexpr std::size_t kShiftEdgeRatio = 8;     // a shift's bands hold at least this many times |dy| rows
 /// Bounds of memory_budget_mb, MiB.
 constexpr double kMinBudgetMb = 1.0;
 constexpr double kMaxBudgetMb = 1048576.0;
@@ -559,45 +560,80 @@ void shiftCells(MapMassGrid& grid, int dx, int dy)
   }
 }
 
-/// Rows of whole blocks: the rows move by dy in one memmove, then each row's cells by dx, rows in parallel, through
-/// @p tmp (per slot, the row between two rows of vacated values) so that eight cells move at a time.
-void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par)
+/// Rows of whole blocks in one pass: destination row y takes source row y + dy, its cells moved by dx through @p tmp
+/// (per slot, the row between two rows of vacated values, so that eight cells move at a time). The rows are cut into
+/// bands, moved in parallel: each band goes in the order that reads its own rows before it overwrites them, and the
+/// (at most |dy|) source rows it reads from other bands are copied into @p edge first. Moving data only, bit-exact.
+void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par, AlignedVector<float>& edge)
 {
   const GridGeometry& g = grid.geometry();
   constexpr std::size_t kB = MapMassGrid::kBlockCells;
   constexpr int kSlots = MapMassGrid::kNumPlanes + 1;
   const std::size_t w = static_cast<std::size_t>(g.width), h = static_cast<std::size_t>(g.height);
   const std::size_t row_floats = w / kB * MapMassGrid::kBlockFloats;
+  const std::size_t reach = static_cast<std::size_t>(std::abs(dy));
+  // Bands of at least kShiftEdgeRatio · |dy| rows: the edge rows stay a small share of the window.
+  const std::size_t band_rows = std::max(kShiftBandRows, kShiftEdgeRatio * reach);
+  const std::size_t bands = (h + band_rows - 1) / band_rows;
+  const std::ptrdiff_t hh = static_cast<std::ptrdiff_t>(h);
   float* const data = grid.planes();
-  auto vacate_rows = [&](std::size_t y0, std::size_t y1) {
-    for (std::size_t b = y0 * w; b < y1 * w; b += kB)
-      for (int s = 0; s < kSlots; ++s) std::fill_n(data + MapMassGrid::blockOffset(b) + s * kB, kB, vacatedValue(s));
+  auto band = [&](std::size_t k) {
+    return std::pair{ static_cast<std::ptrdiff_t>(k * band_rows), static_cast<std::ptrdiff_t>(std::min(h, (k + 1) * band_rows)) };
   };
-  if (dy != 0)
+  // The source rows band k reads outside itself: [e0, e1), at most |dy| of them.
+  auto outside = [&](std::size_t k) {
+    const auto [y0, y1] = band(k);
+    return dy > 0 ? std::pair{ std::max(y1, y0 + dy), std::min(hh, y1 + dy) }
+                  : std::pair{ std::max<std::ptrdiff_t>(0, y0 + dy), std::min(y0, y1 + dy) };
+  };
+  const std::size_t edge_rows = reach;
+  // Saved before anything is written: another band overwrites them.
+  if (edge_rows > 0)
   {
-    const std::size_t moved = h - static_cast<std::size_t>(std::abs(dy));
-    const std::size_t from = dy > 0 ? static_cast<std::size_t>(dy) : 0, to = dy > 0 ? 0 : static_cast<std::size_t>(-dy);
-    std::memmove(data + to * row_floats, data + from * row_floats, moved * row_floats * sizeof(float));
-    if (dy > 0)
-      vacate_rows(moved, h);
-    else
-      vacate_rows(0, to);
+    edge.resize(bands * edge_rows * row_floats);
+    par.forChunks(bands, [&](std::size_t k) {
+      const auto [e0, e1] = outside(k);
+      for (std::ptrdiff_t r = e0; r < e1; ++r)
+        std::memcpy(edge.data() + (k * edge_rows + static_cast<std::size_t>(r - e0)) * row_floats,
+                    data + static_cast<std::size_t>(r) * row_floats, row_floats * sizeof(float));
+    });
   }
-  if (dx == 0) return;
-  par.forRange(h, kShiftRows, [&](std::size_t y0, std::size_t y1) {
+  par.forChunks(bands, [&](std::size_t k) {
     thread_local std::vector<float> tmp;
-    tmp.resize(kSlots * 3 * w);
-    for (int s = 0; s < kSlots; ++s)
+    if (dx != 0)
     {
-      std::fill_n(tmp.data() + s * 3 * w, w, vacatedValue(s));
-      std::fill_n(tmp.data() + s * 3 * w + 2 * w, w, vacatedValue(s));
+      tmp.resize(kSlots * 3 * w);
+      for (int s = 0; s < kSlots; ++s)
+      {
+        std::fill_n(tmp.data() + s * 3 * w, w, vacatedValue(s));
+        std::fill_n(tmp.data() + s * 3 * w + 2 * w, w, vacatedValue(s));
+      }
     }
-    for (std::size_t y = y0; y < y1; ++y)
+    const auto [y0, y1] = band(k);
+    const std::ptrdiff_t e0 = edge_rows > 0 ? outside(k).first : 0;
+    for (std::ptrdiff_t n = 0; n < y1 - y0; ++n)
     {
-      float* const row = data + y * row_floats;
+      const std::ptrdiff_t y = dy >= 0 ? y0 + n : y1 - 1 - n;
+      float* const row = data + static_cast<std::size_t>(y) * row_floats;
+      const std::ptrdiff_t sy = y + dy;
+      if (sy < 0 || sy >= hh)
+      {
+        for (std::size_t b = 0; b < w; b += kB)
+          for (int s = 0; s < kSlots; ++s)
+            std::fill_n(row + b / kB * MapMassGrid::kBlockFloats + s * kB, kB, vacatedValue(s));
+        continue;
+      }
+      const float* const src = sy >= y0 && sy < y1
+                                   ? data + static_cast<std::size_t>(sy) * row_floats
+                                   : edge.data() + (k * edge_rows + static_cast<std::size_t>(sy - e0)) * row_floats;
+      if (dx == 0)
+      {
+        if (src != row) std::memcpy(row, src, row_floats * sizeof(float));
+        continue;
+      }
       for (std::size_t x = 0; x < w; x += kB)
         for (int s = 0; s < kSlots; ++s)
-          std::memcpy(tmp.data() + s * 3 * w + w + x, row + x / kB * MapMassGrid::kBlockFloats + s * kB, kB * sizeof(float));
+          std::memcpy(tmp.data() + s * 3 * w + w + x, src + x / kB * MapMassGrid::kBlockFloats + s * kB, kB * sizeof(float));
       for (std::size_t x = 0; x < w; x += kB)
         for (int s = 0; s < kSlots; ++s)
           std::memcpy(row + x / kB * MapMassGrid::kBlockFloats + s * kB,
@@ -662,7 +698,7 @@ void MapGrid::shift(int dx, int dy)
     return;
   }
   if (g.width % static_cast<int>(MapMassGrid::kBlockCells) == 0)
-    shiftBlockRows(grid_, dx, dy, *parallel_);
+    shiftBlockRows(grid_, dx, dy, *parallel_, shift_edge_);
   else
     shiftCells(grid_, dx, dy);
   if (map_doubt_.size() == g.numCells()) shiftPlane(map_doubt_.data(), g, dx, dy, 0.0f);

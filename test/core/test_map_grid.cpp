@@ -108,11 +108,11 @@ INSTANTIATE_TEST_SUITE_P(BlockRowsAndAnyWidth, MapGridShift, ::testing::Values(2
 
 namespace {
 
-void expectShiftsKeepMassesBitExact(double size_x, int threads)
+void expectShiftsKeepMassesBitExact(double size_x, double size_y, int threads)
 {
   MapGridParams params = defaultParams();
   params.size_x = size_x;
-  params.size_y = 15.0;
+  params.size_y = size_y;
   params.threads = threads;
   MapGrid mg(params);
   ASSERT_EQ(mg.geometry().width % 8 == 0, size_x == 20.0);
@@ -169,12 +169,14 @@ void expectShiftsKeepMassesBitExact(double size_x, int threads)
 
 TEST_P(MapGridShift, KeepsMassesBitExactAtTheirNewIndex)
 {
-  // One to three threads (rows of blocks move in parallel), by up to 16 columns and 12 of the 30 rows.
+  // One to three threads (bands of rows move in parallel), by up to 16 columns and 12 rows, in windows of 30 rows
+  // (one band) and of 100 rows (bands of 32 to 96 rows, which read rows of their neighbours).
   for (int threads : { 1, 2, 3 })
-  {
-    SCOPED_TRACE("threads " + std::to_string(threads));
-    expectShiftsKeepMassesBitExact(GetParam(), threads);
-  }
+    for (double size_y : { 15.0, 50.0 })
+    {
+      SCOPED_TRACE("threads " + std::to_string(threads) + ", " + std::to_string(size_y) + " m");
+      expectShiftsKeepMassesBitExact(GetParam(), size_y, threads);
+    }
 }
 
 TEST(ProjectScan, RotatedWindowSamplesTheScanCellUnderEachCellCentre)

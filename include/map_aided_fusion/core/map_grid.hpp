@@ -379,6 +379,7 @@ private:
   double last_stamp_ = 0.0;
   std::size_t scans_ = 0;
   // MapGridParams::skip_unchanged: StepSkip's flags and kept prior, and the step inputs they hold for (prior, doubt).
+  AlignedVector<float> shift_edge_;  ///< the rows a shift's bands read from each other (shift())
   std::vector<std::uint8_t> stable_;
   AlignedVector<float> kept_[4];
   int skip_inputs_ = -1;
