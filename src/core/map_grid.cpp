@@ -586,15 +586,14 @@ void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par, Alig
     return dy > 0 ? std::pair{ std::max(y1, y0 + dy), std::min(hh, y1 + dy) }
                   : std::pair{ std::max<std::ptrdiff_t>(0, y0 + dy), std::min(y0, y1 + dy) };
   };
-  const std::size_t edge_rows = reach;
   // Saved before anything is written: another band overwrites them.
-  if (edge_rows > 0)
+  if (reach > 0)
   {
-    edge.resize(bands * edge_rows * row_floats);
+    edge.resize(bands * reach * row_floats);
     par.forChunks(bands, [&](std::size_t k) {
       const auto [e0, e1] = outside(k);
       for (std::ptrdiff_t r = e0; r < e1; ++r)
-        std::memcpy(edge.data() + (k * edge_rows + static_cast<std::size_t>(r - e0)) * row_floats,
+        std::memcpy(edge.data() + (k * reach + static_cast<std::size_t>(r - e0)) * row_floats,
                     data + static_cast<std::size_t>(r) * row_floats, row_floats * sizeof(float));
     });
   }
@@ -610,7 +609,7 @@ void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par, Alig
       }
     }
     const auto [y0, y1] = band(k);
-    const std::ptrdiff_t e0 = edge_rows > 0 ? outside(k).first : 0;
+    const std::ptrdiff_t e0 = reach > 0 ? outside(k).first : 0;
     for (std::ptrdiff_t n = 0; n < y1 - y0; ++n)
     {
       const std::ptrdiff_t y = dy >= 0 ? y0 + n : y1 - 1 - n;
@@ -625,7 +624,7 @@ void shiftBlockRows(MapMassGrid& grid, int dx, int dy, const Parallel& par, Alig
       }
       const float* const src = sy >= y0 && sy < y1
                                    ? data + static_cast<std::size_t>(sy) * row_floats
-                                   : edge.data() + (k * edge_rows + static_cast<std::size_t>(sy - e0)) * row_floats;
+                                   : edge.data() + (k * reach + static_cast<std::size_t>(sy - e0)) * row_floats;
       if (dx == 0)
       {
         if (src != row) std::memcpy(row, src, row_floats * sizeof(float));

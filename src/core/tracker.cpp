@@ -1,8 +1,6 @@
 #include "map_aided_fusion/core/tracker.hpp"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <unordered_map>
 
@@ -166,14 +164,6 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
   std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
   for (const std::vector<int>& idx : clusters)
   {
-    {
-      Eigen::Vector2d mm = Eigen::Vector2d::Zero(); double xl=1e9,xh=-1e9,yl=1e9,yh=-1e9;
-      for (int i : idx) { mm += Eigen::Vector2d(points[i].x, points[i].y); xl=std::min(xl,(double)points[i].x); xh=std::max(xh,(double)points[i].x); yl=std::min(yl,(double)points[i].y); yh=std::max(yh,(double)points[i].y);}
-      mm /= static_cast<double>(idx.size());
-      std::size_t ob = 0; if (background) for (int i : idx) ob += (*background)[i] != 0;
-      if (std::getenv("EXP_DBG") && xh > -57 && xl < -27 && yh > 6 && yl < 9)
-        std::fprintf(stderr, "CL n=%zu bg=%zu c=(%.2f,%.2f) bb=[%.1f,%.1f]x[%.1f,%.1f]\n", idx.size(), ob, mm.x(), mm.y(), xl, xh, yl, yh);
-    }
     if (static_cast<int>(idx.size()) < p.min_cluster_points) continue;
     if (background && p.background_share < 1.0)
     {
@@ -585,8 +575,6 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     }
     if (free_now_) seeFreeSpace(t, stamp);
     decideMotion(t, stamp);
-    if (std::getenv("EXP_DBG") && t.x(0) > -57 && t.x(0) < -27 && t.x(1) > 5 && t.x(1) < 10)
-      std::fprintf(stderr, "TR t=%.1f id=%u st=%d mo=%d seen=%d x=(%.2f,%.2f) v=(%.2f,%.2f) s=%.2f sd=%.2f ext=%.2fx%.2f hit=%d\n", stamp, t.id, (int)t.state, (int)t.motion, (int)t.motion_seen, t.x(0), t.x(1), t.x(2), t.x(3), t.speed(), t.speedSigma(), t.extent_length, t.extent_width, t.measurement);
     kept.push_back(std::move(t));
   }
   const double v2 = params_.initial_speed_sigma * params_.initial_speed_sigma;
