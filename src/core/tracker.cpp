@@ -20,6 +20,10 @@ constexpr double kMaxCellSize = 10.0;  // m
 constexpr double kTinySpeed = 1e-6;    // m/s: below, the speed's direction is undefined
 constexpr double kMinStep = 1e-6;      // s between two scans
 constexpr double kMaxDenseCells = 4e6;  // cells of the dense clustering grid (16 MB of indices) before a hash map
+constexpr double kOpenEndsMaxAngle = 20.0 * M_PI / 180.0;  // rad: step open ends probes the cluster's own faces, so it
+                                                            // decides along a box axis this near one of them only
+constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks the view (step open ends)
+constexpr double kOccluderGap = 1.0;   // m: an occluder lies at least this much nearer the sensor than an end it cuts
 constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
@@ -56,6 +60,7 @@ void TrackerParams::validate() const
   requirePositive("tracker_max_gate_distance", max_gate_distance);
   requireInRange("tracker_confirm_hits", confirm_hits, 1, 1000);
   requireInRange("tracker_fragment_margin", fragment_margin, 0.0, max_object_length);
+  requireInRange("tracker_open_end_distance", open_end_distance, 0.0, 10.0);
   requireInRange("tracker_max_coast_time", max_coast_time, 0.0, 60.0);
   requireInRange("tracker_moving_speed", moving_speed, 0.0, 100.0);
   requireInRange("tracker_motion_sigmas", motion_sigmas, 0.0, 10.0);
@@ -230,8 +235,56 @@ AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis)
       a.hi = std::max(a.hi, x);
     }
   const Eigen::Vector2d sensor(m.sensor.x - m.centroid.x, m.sensor.y - m.centroid.y);
-  a.near_lo = sensor.dot(axis) < 0.5 * (a.lo + a.hi);
+  const bool near_lo = sensor.dot(axis) < 0.5 * (a.lo + a.hi);
+  a.anchor_lo = near_lo;
+  if (m.ends_seen)
+  {
+    const double du = mu.dot(axis), dv = mv.dot(axis);
+    const bool major = std::abs(du) >= std::abs(dv);
+    if (std::max(std::abs(du), std::abs(dv)) < std::cos(kOpenEndsMaxAngle)) return a;
+    const double d = major ? du : dv;
+    const std::uint8_t low = major ? Measurement::kLowU : Measurement::kLowV;
+    const std::uint8_t high = major ? Measurement::kHighU : Measurement::kHighV;
+    const std::uint8_t lo_bit = d > 0.0 ? low : high, hi_bit = d > 0.0 ? high : low;
+    const std::uint8_t near_bit = near_lo ? lo_bit : hi_bit, far_bit = near_lo ? hi_bit : lo_bit;
+    if ((m.occluded & near_bit) && (m.open & far_bit)) a.anchor_lo = !near_lo;
+  }
   return a;
+}
+
+bool hiddenFromSensor(const ScanMassGrid& scan, const Pose2& pose, Point2 p, double gap)
+{
+  const GridGeometry& g = scan.geometry();
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw), dx = p.x - pose.x, dy = p.y - pose.y;
+  const double vx = c * dx + s * dy, vy = -s * dx + c * dy, range = std::hypot(vx, vy), reach = range - gap;
+  if (!(reach > 0.0)) return false;
+  const float* occupied = scan.plane(FrameSG::kO);
+  const double step = 0.5 * g.resolution;
+  for (double r = step; r <= reach; r += step)
+  {
+    CellIndex cell;
+    if (!g.worldToCell(Point2{ vx * r / range, vy * r / range }, cell)) return false;
+    if (occupied[g.index(cell)] >= kOccluderMass) return true;
+  }
+  return false;
+}
+
+void findOpenEnds(Measurement& m, const SeenFree& free, const ScanMassGrid& scan, const Pose2& pose, double distance)
+{
+  const Eigen::Vector2d c(m.centroid.x, m.centroid.y), mu(std::cos(m.yaw), std::sin(m.yaw)), mv(-mu.y(), mu.x());
+  const double mid_u = 0.5 * (m.lo_u + m.hi_u), mid_v = 0.5 * (m.lo_v + m.hi_v);
+  m.open = m.occluded = 0;
+  auto probe = [&](double u, double v, std::uint8_t bit) {
+    const Eigen::Vector2d q = c + u * mu + v * mv;
+    const Point2 p{ q.x(), q.y() };
+    if (free.clear(p)) m.open |= bit;
+    if (hiddenFromSensor(scan, pose, p, distance + kOccluderGap)) m.occluded |= bit;
+  };
+  probe(m.lo_u - distance, mid_v, Measurement::kLowU);
+  probe(m.hi_u + distance, mid_v, Measurement::kHighU);
+  probe(mid_u, m.lo_v - distance, Measurement::kLowV);
+  probe(mid_u, m.hi_v + distance, Measurement::kHighV);
+  m.ends_seen = true;
 }
 
 namespace {
@@ -242,11 +295,11 @@ bool anchored(const Track& t, const Measurement& m)
 }
 
 /// Offset of the track's box centre from the centroid along one axis: the middle of the cluster when it is as long as
-/// the box, else the box placed on the cluster's end nearest the sensor.
+/// the box, else the box placed on the cluster's anchoring end (viewAlong()).
 double centreAlong(const AxisView& a, double extent)
 {
   if (std::abs((a.hi - a.lo) - extent) <= kAnchorTolerance) return 0.5 * (a.lo + a.hi);
-  return a.near_lo ? a.lo + 0.5 * extent : a.hi - 0.5 * extent;
+  return a.anchor_lo ? a.lo + 0.5 * extent : a.hi - 0.5 * extent;
 }
 
 }  // namespace
@@ -326,7 +379,7 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
   }
   if (anchored(t, m))
   {
-    // A longer cluster than the box: the box grows away from the sensor; its centre moves, the object does not.
+    // A longer cluster than the box: the box grows away from its anchoring end; its centre moves, the object does not.
     const Eigen::Vector2d tu(std::cos(t.extent_yaw), std::sin(t.extent_yaw)), tv(-tu.y(), tu.x());
     for (auto [axis, extent] : { std::pair<Eigen::Vector2d, double*>{ tu, &t.extent_length },
                                  std::pair<Eigen::Vector2d, double*>{ tv, &t.extent_width } })
@@ -334,7 +387,7 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
       const AxisView a = viewAlong(m, axis);
       const double grown = (a.hi - a.lo) - *extent;
       if (grown <= kAnchorTolerance) continue;
-      t.x.head<2>() += (a.near_lo ? 0.5 : -0.5) * grown * axis;
+      t.x.head<2>() += (a.anchor_lo ? 0.5 : -0.5) * grown * axis;
       *extent = a.hi - a.lo;
     }
   }
@@ -437,7 +490,8 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   }
   last_pose_ = pose;
   free_now_ = scan && params_.free_space_check;
-  if (free_now_)
+  const bool open_ends = scan && params_.open_ends;
+  if (free_now_ || open_ends)
   {
     const double oldest = stamp - params_.free_space_time - kMinStep;
     seen_free_.erase(std::remove_if(seen_free_.begin(), seen_free_.end(),
@@ -469,6 +523,7 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   {
     m.has_sensor = true;
     m.sensor = Point2{ pose.x, pose.y };
+    if (open_ends) findOpenEnds(m, seen_free_.back(), *scan, pose, params_.open_end_distance);
   }
   own_measurements_ = std::move(found);
   update(stamp, own_measurements_);

@@ -1001,3 +1001,120 @@ TEST(Tracker, TrackEvidenceSizeParametersAreValidatedByName)
       { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },
       { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } } });
 }
+
+namespace {
+
+constexpr double kOccluderY = 5.5, kOccluderHalf = 1.8;  // a parked car's face across the line of sight, at the origin's x
+
+/// True behind the parked car's face, as seen from a sensor at the origin.
+bool inShadow(Point2 q) { return q.y > kOccluderY && std::abs(q.x) < q.y * kOccluderHalf / kOccluderY; }
+
+std::vector<Point2> occluderFace()
+{
+  std::vector<Point2> face;
+  for (double x = -kOccluderHalf; x <= kOccluderHalf + 1e-9; x += 0.1) face.push_back(Point2{ x, kOccluderY });
+  return face;
+}
+
+/// The near side (y = 9.1) of a 4 m car driving along +x at 10 m/s, 9 m from a sensor at the origin, out of the shadow
+/// of a parked car's face (inShadow(), whose edge is at x = 2.98 on the car's side): returns every 0.1 m on the part
+/// seen and on the face, and the ScanGrid, free up to y = 12 but in the shadow and on and behind the car. Returns the
+/// track nearest the car's centre after @p scans scans, whose true x is @p true_x.
+Track emergeFromShadow(bool open_ends, int scans, double& true_x)
+{
+  TrackerParams params;
+  params.open_ends = open_ends;
+  Tracker tracker(params);
+  constexpr double kSpeed = 10.0, kDt = 0.1, kSide = 9.1, kLength = 4.0;
+  const double edge = kSide * kOccluderHalf / kOccluderY;
+  Track last;
+  for (int k = 0; k < scans; ++k)
+  {
+    const double front = edge + 0.2 + kSpeed * kDt * k;
+    true_x = front - 0.5 * kLength;
+    std::vector<Point2> seen = occluderFace();
+    for (double x = std::max(front - kLength, edge + 0.05); x <= front + 1e-9; x += 0.1) seen.push_back(Point2{ x, kSide });
+    const std::vector<float> xy = flatten(seen);
+    auto car = [&](Point2 q) { return q.y > kSide - 0.5 && q.x > front - kLength - 0.3 && q.x < front + 0.3; };
+    const ScanMassGrid scan = scanGrid(xy, [&](Point2 q) { return !inShadow(q) && !car(q) && q.y < 12.0; });
+    tracker.update(kDt * k, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, &scan);
+  }
+  for (const Track& t : tracker.tracks())
+    if (last.id == 0 || std::abs(t.x(0) - true_x) + std::abs(t.x(1) - kSide) <
+                            std::abs(last.x(0) - true_x) + std::abs(last.x(1) - kSide))
+      last = t;
+  return last;
+}
+
+}  // namespace
+
+TEST(Tracker, OpenEndsAnchorOnTheOtherEndWhenAnOccluderCutsTheNearOne)
+{
+  // A 1.9 m line of returns along x from x = 3.1 at y = 9.1, the sensor at the origin: its end nearest the sensor
+  // (x = 3.1) lies just past the shadow of a parked car's face; the scan saw free space beyond x = 5.
+  std::vector<Point2> line;
+  for (double x = 3.1; x < 5.05; x += 0.1) line.push_back(Point2{ x, 9.1 });
+  std::vector<Point2> all = occluderFace();
+  all.insert(all.end(), line.begin(), line.end());
+  const std::vector<float> xy = flatten(all);
+  auto seen_free = [](Point2 q) { return !inShadow(q) && q.y < 8.6; };
+  const ScanMassGrid scan = scanGrid(xy, [&](Point2 q) { return seen_free(q) || (q.x > 5.1 && q.y < 12.0); });
+  const Pose2 origin{};
+  const SeenFree free(scan, origin, 0.0, 0.5);
+  TrackerParams params;
+  params.min_cluster_points = 5;
+  std::vector<Measurement> found = clusterReturns(line, params);
+  ASSERT_EQ(found.size(), 1u);
+  Measurement m = found[0];
+  m.has_sensor = true;
+  const bool u_along_x = std::cos(m.yaw) > 0.0;
+  const std::uint8_t plus_x = u_along_x ? Measurement::kHighU : Measurement::kLowU;
+  const std::uint8_t minus_x = u_along_x ? Measurement::kLowU : Measurement::kHighU;
+  const Eigen::Vector2d along_x(1.0, 0.0);
+  EXPECT_TRUE(viewAlong(m, along_x).anchor_lo) << "without the step: the end nearest the sensor, x = 3.1";
+
+  findOpenEnds(m, free, scan, origin, 1.0);
+  ASSERT_TRUE(m.ends_seen);
+  EXPECT_TRUE(m.open & plus_x) << "free space 1 m beyond x = 5";
+  EXPECT_FALSE(m.open & minus_x) << "the shadow before x = 3.1";
+  EXPECT_TRUE(m.occluded & minus_x) << "the parked car blocks the view of x = 2.1";
+  EXPECT_FALSE(m.occluded & plus_x);
+  EXPECT_FALSE(viewAlong(m, along_x).anchor_lo) << "the open end, x = 5";
+  EXPECT_TRUE(viewAlong(m, -along_x).anchor_lo) << "the same end along −x";
+  EXPECT_TRUE(hiddenFromSensor(scan, origin, Point2{ 2.0, 9.1 }, 2.0));
+  EXPECT_FALSE(hiddenFromSensor(scan, origin, Point2{ 2.0, 9.1 }, 4.0)) << "the face is 3.7 m before the point";
+  // The near end not occluded, or the far end not open: the end nearest the sensor.
+  Measurement clear_near = m, closed_far = m;
+  clear_near.occluded = 0;
+  closed_far.open = 0;
+  EXPECT_TRUE(viewAlong(clear_near, along_x).anchor_lo);
+  EXPECT_TRUE(viewAlong(closed_far, along_x).anchor_lo);
+  // An axis 30° off the cluster's: the end nearest the sensor.
+  const Eigen::Vector2d askew(std::cos(M_PI / 6), std::sin(M_PI / 6));
+  Measurement by_sensor = m;
+  by_sensor.ends_seen = false;
+  EXPECT_EQ(viewAlong(m, askew).anchor_lo, viewAlong(by_sensor, askew).anchor_lo);
+}
+
+TEST(Tracker, OpenEndsFollowTheFrontOfACarComingOutOfAShadow)
+{
+  // The end nearest the sensor is the shadow's edge, which stands still while the car comes out, so a box anchored on
+  // it lags; the open end is the car's front.
+  double true_x = 0.0;
+  const Track with = emergeFromShadow(true, 8, true_x);
+  const Track without = emergeFromShadow(false, 8, true_x);
+  ASSERT_GT(with.id, 0u);
+  ASSERT_GT(without.id, 0u);
+  const double err_with = std::abs(with.x(2) - 10.0), err_without = std::abs(without.x(2) - 10.0);
+  EXPECT_LT(err_with, 0.5 * err_without) << "vx with " << with.x(2) << ", without " << without.x(2);
+  EXPECT_LT(err_with, 1.0) << "vx " << with.x(2);
+  EXPECT_LT(std::abs(with.x(0) - true_x), 0.5) << "the box's centre, " << with.x(0) << " for " << true_x;
+  EXPECT_NEAR(with.extent_length, 4.0, 0.3);
+}
+
+TEST(Tracker, OpenEndDistanceIsValidatedByName)
+{
+  expectRefusedByName({ { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = -0.1; } },
+                        { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = 11.0; } },
+                        { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = std::nan(""); } } });
+}

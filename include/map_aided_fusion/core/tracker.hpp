@@ -116,6 +116,15 @@ struct TrackerParams
   /// reports (reportedBox(): the tracks topic, the scoring) the box of step hidden length and its centre, half a
   /// vehicle's length behind the face seen, instead of the face's.
   bool hidden_centre = true;
+  /// Step "open ends": which end of a partly seen cluster is the object's end. The box of a cluster shorter than the
+  /// track's is anchored on the cluster's end nearest the sensor, but an occluder nearer the sensor can cut exactly
+  /// that end (a car coming out of the shadow of a parked car on the sensor's side). Along each axis of the box
+  /// within 20° of the cluster's, when the sensor's line of sight to the point open_end_distance beyond the near end
+  /// is blocked by an obstacle at least 1 m nearer, and the scan saw free space (SeenFree at free_space_margin) at
+  /// that distance beyond the other end, the other end anchors the box (referencePoint(), the box's growth).
+  /// Needs a ScanGrid.
+  bool open_ends = true;
+  double open_end_distance = 1.0;  ///< m in [0, 10]: how far beyond a cluster's end its point of both tests lies
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -168,6 +177,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
   get("tracker_evidence_small_size", p.evidence_small_size, { "m", "step small movers: a moving track at most this long and wide also moves the sets holding N to V; 0: off" });
   get("tracker_evidence_small_box", p.evidence_small_box, { "", "step small box: a small mover's track box is grown to tracker_evidence_small_size along and across the line of sight" });
+  get("tracker_open_ends", p.open_ends, { "", "step open ends: a partly seen cluster whose end nearest the sensor is occluded, and the other open, is anchored on the other" });
+  get("tracker_open_end_distance", p.open_end_distance, { "m", "how far beyond a cluster's end step open ends looks for free space and for an occluder's shadow" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -201,19 +212,39 @@ struct Measurement
   int points = 0;
   bool has_sensor = false;  ///< the sensor position is known (the end of a partly seen object nearest it is real)
   Point2 sensor;            ///< map frame
+  /// Step open ends, when ends_seen: the faces of the box (kLowU … kHighV) with free space beyond them, and those the
+  /// sensor cannot see past because a nearer obstacle blocks its line of sight.
+  std::uint8_t open = 0, occluded = 0;
+  bool ends_seen = false;
+  static constexpr std::uint8_t kLowU = 1, kHighU = 2, kLowV = 4, kHighV = 8;
   std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
 };
 
 /// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
-/// one nearest the sensor.
+/// object's end, on which a longer box is anchored.
 struct AxisView
 {
   double lo = 0.0, hi = 0.0;
-  bool near_lo = true;
+  bool anchor_lo = true;
 };
 
-/// The box of @p m (its four corners) seen along the unit vector @p axis (map frame).
+/**
+ * @brief The box of @p m (its four corners) seen along the unit vector @p axis (map frame). It is anchored on its end
+ *        nearest the sensor, unless (Measurement::ends_seen, step open ends, along an axis within 20° of one of the
+ *        cluster's) that end is occluded and the other open: then on the other.
+ */
 AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis);
+
+/**
+ * @brief Step open ends: the open and occluded faces of @p m's box, from one scan. A face is open when the point
+ *        @p distance beyond its middle is clear in @p free, occluded when the line of sight from the vehicle at
+ *        @p pose to that point is blocked in @p scan (hiddenFromSensor()) at least 1 m before it. Sets ends_seen.
+ */
+void findOpenEnds(Measurement& m, const SeenFree& free, const ScanMassGrid& scan, const Pose2& pose, double distance);
+
+/// True when the line of sight from the vehicle (the ScanGrid's origin, at @p pose) to the map-frame point @p p crosses
+/// a ScanGrid cell with m(O) ≥ 0.5 at least @p gap metres before @p p.
+bool hiddenFromSensor(const ScanMassGrid& scan, const Pose2& pose, Point2 p, double gap);
 
 /**
  * @brief Clusters map-frame returns: cells of cluster_distance / 2 holding returns, 8-connected, are one cluster.
