@@ -105,6 +105,7 @@ void BM_TrackerScan(benchmark::State& state)
   for (int k = 0; k < kScenes; ++k) scanScene(n, k, rng, xy[k], grids[k]);
   TrackerParams params;
   params.free_space_check = state.range(1) != 0;
+  params.open_ends = state.range(2) != 0;
   Tracker tracker(params);
   int k = 0;
   for (auto _ : state)
@@ -118,6 +119,11 @@ void BM_TrackerScan(benchmark::State& state)
 
 }  // namespace
 
-BENCHMARK(BM_TrackerScan)->ArgNames({ "n", "free_space_check" })->Args({ 200, 0 })->Args({ 200, 1 })->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TrackerScan)
+    ->ArgNames({ "n", "free_space_check", "open_ends" })
+    ->Args({ 200, 0, 0 })
+    ->Args({ 200, 1, 0 })
+    ->Args({ 200, 1, 1 })
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TrackerUpdate)->Arg(200)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ClusterReturns)->Arg(200)->Unit(benchmark::kMicrosecond);
