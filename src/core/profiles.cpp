@@ -88,7 +88,7 @@ Profile withoutAddedSteps(Profile p)
 namespace {
 
 constexpr double kCarSelfBoxRear = -2.7;   // m, x of the car's rear from the lidar
-constexpr double kCarSelfBoxFront = 1.8;   // m, x of its front (bonnet and mirrors) from the lidar
+constexpr double kCarSelfBoxFront = 2.7;   // m, x of its front (the bonnet, which KITTI's lidar sees at 2.5 m)
 constexpr double kCarSelfBoxHalfWidth = 1.7;  // m, half its width with the mirrors, and a margin
 
 }  // namespace

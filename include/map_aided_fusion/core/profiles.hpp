@@ -50,8 +50,8 @@ Profile paperProfile();
 Profile defaultProfile();
 
 /// Sets @p p's self box to a passenger car's with its lidar on the roof, base_link on the ground under the lidar:
-/// x in [−2.7, 1.8] m, y in [−1.7, 1.7] m (KITTI's car returns its own roof edges and mirrors up to 1.6 m beside
-/// the lidar). The paper's profile has none.
+/// x in [−2.7, 2.7] m, y in [−1.7, 1.7] m (KITTI's car returns its own roof edges and mirrors up to 1.6 m beside
+/// the lidar, and its bonnet 2.5 m ahead of it). The paper's profile has none.
 void carSelfBox(ScanGridParams& p);
 
 /// @p p with every step this package adds to the paper switched off (the rest unchanged).
