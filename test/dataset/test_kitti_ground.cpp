@@ -75,16 +75,20 @@ Score score(const dataset::KittiSequence& s, std::size_t frame, const std::strin
   return out;
 }
 
+/// The shared KITTI 00 frames; prints SKIPPED when they are absent.
+fs::path kitti00()
+{
+  const fs::path dir = fs::path(MAF_SHARED_DATA_DIR) / "lidar" / "kitti_00";
+  if (!fs::exists(dir / "times.txt")) std::printf("SKIPPED: %s is absent\n", dir.string().c_str());
+  return dir;
+}
+
 }  // namespace
 
 TEST(KittiGround, PlanesKeepTheRoadAheadFreeAndParkedCarsOccupied)
 {
-  const fs::path dir = fs::path(MAF_SHARED_DATA_DIR) / "lidar" / "kitti_00";
-  if (!fs::exists(dir / "times.txt"))
-  {
-    std::printf("SKIPPED: %s is absent\n", dir.string().c_str());
-    GTEST_SKIP() << dir << " is absent";
-  }
+  const fs::path dir = kitti00();
+  if (!fs::exists(dir / "times.txt")) GTEST_SKIP() << dir << " is absent";
   const dataset::KittiSequence s(dir.string());
   ASSERT_GE(s.labelledFrames(), 1u);
   for (std::size_t k = 0; k < s.size(); ++k)
@@ -110,12 +114,8 @@ TEST(KittiGround, TheDefaultSelfBoxHoldsTheCarsOwnBonnet)
 {
   // KITTI's lidar sees its own car's bonnet 2.5 m ahead, 0.8 m above the ground, on most sweeps: returns that move
   // with the vehicle, which the tracker would call a moving object. The default self box must reject them.
-  const fs::path dir = fs::path(MAF_SHARED_DATA_DIR) / "lidar" / "kitti_00";
-  if (!fs::exists(dir / "times.txt"))
-  {
-    std::printf("SKIPPED: %s is absent\n", dir.string().c_str());
-    GTEST_SKIP() << dir << " is absent";
-  }
+  const fs::path dir = kitti00();
+  if (!fs::exists(dir / "times.txt")) GTEST_SKIP() << dir << " is absent";
   const dataset::KittiSequence s(dir.string());
   constexpr float kBonnetMin = 2.3f, kBonnetMax = 2.7f, kBonnetHalfWidth = 0.7f;  // m, lidar frame
   constexpr float kBonnetLow = 0.6f, kBonnetHigh = 1.0f;                             // m above the ground
