@@ -493,7 +493,8 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   const bool open_ends = scan && params_.open_ends;
   if (free_now_ || open_ends)
   {
-    const double oldest = stamp - params_.free_space_time - kMinStep;
+    // The free-space check compares the scans of free_space_time; step open ends needs this scan's only.
+    const double oldest = free_now_ ? stamp - params_.free_space_time - kMinStep : stamp;
     seen_free_.erase(std::remove_if(seen_free_.begin(), seen_free_.end(),
                                     [&](const SeenFree& f) { return f.stamp() < oldest || f.stamp() >= stamp; }),
                      seen_free_.end());

@@ -124,7 +124,7 @@ struct TrackerParams
   /// that distance beyond the other end, the other end anchors the box (referencePoint(), the box's growth).
   /// Needs a ScanGrid.
   bool open_ends = true;
-  double open_end_distance = 1.0;  ///< m in [0, 10]: how far beyond a cluster's end its point of both tests lies
+  double open_end_distance = 1.0;  ///< m in [0, 10]: how far beyond a cluster's end both tests look
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
