@@ -14,6 +14,16 @@ namespace {
 
 double distance(core::Point2 a, core::Point2 b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
+/// Distance from @p p to the footprint of @p o (0 inside it).
+double distanceToFootprint(const MotObject& o, core::Point2 p)
+{
+  const double dx = p.x - o.position.x, dy = p.y - o.position.y;
+  const double c = std::cos(o.yaw), s = std::sin(o.yaw);
+  const double u = std::max(0.0, std::abs(c * dx + s * dy) - 0.5 * std::max(0.0, o.length));
+  const double v = std::max(0.0, std::abs(-s * dx + c * dy) - 0.5 * std::max(0.0, o.width));
+  return std::hypot(u, v);
+}
+
 double median(std::vector<double> v)
 {
   if (v.empty()) return std::nan("");
@@ -71,7 +81,7 @@ void ClearMot::addFrame(const std::vector<MotObject>& objects, const std::vector
       object_to_hyp[free_objects[r]] = free_hyps[pairs[r]];
       hyp_used[free_hyps[pairs[r]]] = 1;
     }
-  // 3. Hypotheses on objects that are not judged are left out.
+  // 3. Hypotheses on (within the match distance of the footprint of) objects that are not judged are left out.
   if (!ignored.empty())
   {
     std::vector<int> rest;
@@ -79,7 +89,7 @@ void ClearMot::addFrame(const std::vector<MotObject>& objects, const std::vector
       if (!hyp_used[j]) rest.push_back(j);
     for (int j : rest)
       for (int i : ignored)
-        if (distance(objects[i].position, hypotheses[j].position) <= threshold_)
+        if (distanceToFootprint(objects[i], hypotheses[j].position) <= threshold_)
         {
           hyp_used[j] = 2;
           break;

@@ -346,6 +346,9 @@ std::vector<MotObject> motObjects(const std::vector<TruthObject>& objects, const
     m.judged = o.cell_class == CellClass::kMoving && seen.count(o.id);
     m.has_velocity = true;
     m.velocity = core::Point2{ o.vx, o.vy };
+    m.length = o.length;
+    m.width = o.width;
+    m.yaw = o.yaw;
     out.push_back(m);
   }
   return out;

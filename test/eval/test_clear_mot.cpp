@@ -92,6 +92,41 @@ TEST(ClearMot, HypothesesOnObjectsNotJudgedAreLeftOut)
   EXPECT_DOUBLE_EQ(mot.mota(), 0.0);
 }
 
+// A 12 m bus along +y, not judged (a mover not seen by the scoring, or parked). A track on its
+// near end, 4 m from its centre, lies in its footprint and is left out; 1.9 m beside its side too; 2.1 m beyond its
+// end, or 3 m from a point object, is a false positive. The footprint is rotated with the object's yaw.
+TEST(ClearMot, HypothesesWithinTheMatchDistanceOfTheFootprintOfAnObjectNotJudgedAreLeftOut)
+{
+  MotObject bus = obj(1, 10, 5, false);
+  bus.length = 12.0;
+  bus.width = 2.5;
+  bus.yaw = 0.5 * M_PI;  // along +y: its ends at y = -1 and y = 11, its sides at x = 8.75 and 11.25
+  {
+    ClearMot mot(2.0);
+    mot.addFrame({ bus }, { hyp(1, 10, 9), hyp(2, 11.25 + 1.9, 5), hyp(3, 10, 11 + 2.1), hyp(4, 8.75 - 2.1, 5) });
+    EXPECT_EQ(mot.falsePositives(), 2u);  // h3 and h4
+    EXPECT_EQ(mot.objects(), 0u);
+  }
+  {
+    // Without its footprint (0 x 0: a point), only a hypothesis within 2 m of its centre is left out.
+    MotObject point = bus;
+    point.length = point.width = 0.0;
+    ClearMot mot(2.0);
+    mot.addFrame({ point }, { hyp(1, 10, 9), hyp(2, 10, 6.9) });
+    EXPECT_EQ(mot.falsePositives(), 1u);  // h1, 4 m away
+  }
+  {
+    // A judged object is still paired by its centre: a track on the bus's end, 4 m from its centre, is a false
+    // positive and the bus a miss.
+    MotObject judged = bus;
+    judged.judged = true;
+    ClearMot mot(2.0);
+    mot.addFrame({ judged }, { hyp(1, 10, 9) });
+    EXPECT_EQ(mot.falsePositives(), 1u);
+    EXPECT_EQ(mot.misses(), 1u);
+  }
+}
+
 TEST(ClearMot, GlobalAssignmentPairsBothObjects)
 {
   // Greedy nearest-first would pair o1 with h2 (0.5) and leave o2 (1.8 from h2 only... and 2.5 from h1) unpaired;

@@ -8,8 +8,9 @@
  * assignment (core/assignment.hpp) that makes as many pairs as possible within the match distance and, among
  * those, minimises the summed distance. A new pair whose object was last paired with another hypothesis is an
  * identity switch. Unpaired judged objects are misses, unpaired hypotheses false positives — except hypotheses
- * within the match distance of an object that is not judged (a parked car or one whose motion is ambiguous, when
- * only movers are scored): those are left out.
+ * within the match distance of the footprint of an object that is not judged (a parked car, one whose motion is
+ * ambiguous or a mover out of sight, when only seen movers are scored): those are left out. The footprint, not the
+ * centre, so that a track on the near end of a bus seen end-on, which is a real object, is not a false positive.
  *
  *  - MOTA = 1 − (misses + false positives + identity switches) / judged objects, summed over frames;
  *  - MOTP = summed distance of the pairs / number of pairs (metres; lower is better);
@@ -38,6 +39,9 @@ struct MotObject
   bool judged = true;  ///< false: not scored (a hypothesis on it is neither a match nor a false positive)
   bool has_velocity = false;
   core::Point2 velocity;  ///< m/s, when has_velocity
+  /// Footprint (m, rad) about position, for the objects that are not judged: a hypothesis within the match distance
+  /// of it is left out. 0 × 0: a point.
+  double length = 0.0, width = 0.0, yaw = 0.0;
 };
 
 /// A tracker's hypothesis (track) in one frame.
