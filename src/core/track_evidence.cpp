@@ -10,6 +10,8 @@ namespace core {
 namespace {
 
 constexpr double kMinSigma = 1e-6;  // m/s
+constexpr int kBetPBuilding = 1;     // the BetP plane of C (FrameMG::kC is bit 1)
+static_assert(FrameMG::kC == 1u << kBetPBuilding, "BetP planes are in bit order");
 
 double normalCdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
@@ -204,10 +206,15 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
 {
   const GridGeometry& g = grid.geometry();
   const MapMassGrid& masses = grid.masses();
-  backgroundFlags(pose, returns, tracker.params().background_zeta,
-                  [&](Point2 p) {
+  const TrackerParams& p = tracker.params();
+  const AlignedVector<float>& betp_c = grid.pignistic()[kBetPBuilding];
+  const bool building = p.building_background && betp_c.size() == g.numCells();
+  backgroundFlags(pose, returns,
+                  [&](Point2 q) {
                     CellIndex c;
-                    return g.worldToCell(p, c) ? masses.zeta(g.index(c)) : -1.0f;
+                    if (!g.worldToCell(q, c)) return false;
+                    const std::size_t i = g.index(c);
+                    return masses.zeta(i) > p.background_zeta || (building && betp_c[i] > p.background_building);
                   },
                   background);
   tracker.update(stamp, pose, returns, &background, scan);

@@ -50,6 +50,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_min_cluster_points", min_cluster_points, 1, 1e6);
   requireUnit("tracker_background_zeta", background_zeta);
   requireUnit("tracker_background_share", background_share);
+  requireUnit("tracker_background_building", background_building);
   requirePositive("tracker_max_object_length", max_object_length);
   requirePositive("tracker_max_object_width", max_object_width);
   requirePositive("tracker_measurement_sigma", measurement_sigma);

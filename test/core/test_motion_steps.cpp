@@ -8,6 +8,7 @@
 
 #include "map_aided_fusion/core/fusion.hpp"
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/prior.hpp"
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/core/track_evidence.hpp"
@@ -586,6 +587,58 @@ TEST(MotionSteps, MarkHiddenFlagsTheInteriorCellsTheScanDidNotSeeFree)
   {
     const bool behind = g.cellCentre(g.cellOf(m.cell)).y > 4.0;
     EXPECT_EQ(m.hidden, behind && m.interior && m.motion == CellClass::kMoving);
+  }
+}
+
+// Step building background: a facade the map has (prior B) and an unmapped box, both seen for the first time. With
+// the step, the facade's returns lie on static background from that first scan (BetP(C) > 0.5), the box's do not;
+// without it, neither does (their counter ζ has grown by one δ_inc only).
+TEST(MotionSteps, BuildingBackgroundFlagsTheReturnsOnAMappedFacadeFromItsFirstScan)
+{
+  World world;
+  world.boxes.push_back({ 20.0, -10.0, 21.0, 10.0, 3.0 });  // the mapped facade
+  world.boxes.push_back({ -15.0, -1.0, -13.0, 1.0, 1.5 });  // an unmapped box
+  PriorWindow prior(GridGeometry::centred(200.0, 200.0, 0.5));
+  const PriorConfidence beta;
+  for (std::size_t i = 0; i < prior.building.size(); ++i)
+  {
+    const Point2 p = prior.geometry.cellCentre(prior.geometry.cellOf(i));
+    const bool facade = p.x > 19.5 && p.x < 21.5 && p.y > -10.5 && p.y < 10.5;
+    const auto m = priorMass(facade ? PriorClass::kBuilding : PriorClass::kOther, beta);
+    prior.building[i] = static_cast<float>(m[FrameMG::kBuilding]);
+    prior.other[i] = static_cast<float>(m[FrameMG::kOther]);
+  }
+  const Pose2 pose{ 0.0, 0.0, 0.0 };
+  for (const bool step : { true, false })
+  {
+    Profile profile = defaultProfile();
+    profile.tracker.building_background = step;
+    core::Run run(profile);
+    run.step(world, pose, &prior);
+    Tracker tracker(profile.tracker);
+    std::vector<std::uint8_t> background;
+    const ObstaclePoints returns = run.builder.obstaclePoints();
+    trackScan(tracker, run.grid, kScanPeriod, pose, returns, background, &run.scan);
+    ASSERT_EQ(background.size(), returns.count);
+    int facade = 0, facade_flagged = 0, box = 0, box_flagged = 0;
+    for (std::size_t i = 0; i < returns.count; ++i)
+    {
+      const double x = returns.xy[2 * i];
+      if (x > 19.0)
+      {
+        ++facade;
+        facade_flagged += background[i];
+      }
+      else if (x < -12.0)
+      {
+        ++box;
+        box_flagged += background[i];
+      }
+    }
+    ASSERT_GT(facade, 50) << "the facade is seen";
+    ASSERT_GT(box, 10) << "the box is seen";
+    EXPECT_EQ(facade_flagged, step ? facade : 0) << "step " << step;
+    EXPECT_EQ(box_flagged, 0) << "step " << step;
   }
 }
 

@@ -299,7 +299,8 @@ TEST(Tracker, ClustersMostlyOnStaticBackgroundAreNoCandidates)
   // ζ by map y: background (0.9) at y = 2, borderline (0.2) at y = 3, outside the grid (-1) at y = 4.
   auto zeta = [](Point2 p) { return p.y > 1.5 && p.y < 2.5 ? 0.9 : p.y > 2.5 && p.y < 3.5 ? 0.2 : p.y > 3.5 ? -1.0 : 0.0; };
   std::vector<std::uint8_t> flags;
-  backgroundFlags(Pose2{ 10.0, 0.0, M_PI / 2 }, ObstaclePoints{ xy.data(), 4 }, 0.2, zeta, flags);
+  backgroundFlags(Pose2{ 10.0, 0.0, M_PI / 2 }, ObstaclePoints{ xy.data(), 4 }, [&](Point2 p) { return zeta(p) > 0.2; },
+                  flags);
   EXPECT_EQ(flags, (std::vector<std::uint8_t>{ 0, 1, 0, 0 }));
 
   TrackerParams p;

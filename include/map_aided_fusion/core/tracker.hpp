@@ -37,6 +37,12 @@ struct TrackerParams
   /// … and a cluster with more than this share of its returns on background is no moving-object candidate, not
   /// tracked; 1: off.
   double background_share = 0.5;
+  /// Step "building background": a return on a MapGrid cell whose BetP(C) (a mapped building: the PriorGrid's B,
+  /// kept by the fusion) is above background_building lies on static background too. A facade first seen far away,
+  /// before its counter has grown, slides along its visible part while the vehicle drives and made false moving
+  /// tracks. Without a prior BetP(C) is 0 and the step does nothing.
+  bool building_background = true;
+  double background_building = 0.5;  ///< BetP(C) in [0, 1] above which a return lies on a mapped building
   double max_object_length = 18.0;   ///< m: a longer cluster (a wall, a fence, a hedge) is no object; an articulated bus is shorter
   double max_object_width = 4.0;     ///< m: a wider cluster is no object
   double measurement_sigma = 0.15;   ///< m, standard deviation of a compact cluster's centroid
@@ -139,6 +145,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_min_cluster_points", p.min_cluster_points, { "returns", "a cluster with fewer returns is no measurement" });
   get("tracker_background_zeta", p.background_zeta, { "", "a return on a cell whose counter ζ is above this lies on static background" });
   get("tracker_background_share", p.background_share, { "", "a cluster with more than this share of background returns is not tracked; 1: off" });
+  get("tracker_building_background", p.building_background, { "", "step building background: a return on a cell decided mapped building (BetP(C) above tracker_background_building) lies on static background too" });
+  get("tracker_background_building", p.background_building, { "", "BetP(C) above which a return lies on a mapped building" });
   get("tracker_max_object_length", p.max_object_length, { "m", "a longer cluster (wall, fence, hedge) is no object" });
   get("tracker_max_object_width", p.max_object_width, { "m", "a wider cluster is no object" });
   get("tracker_measurement_sigma", p.measurement_sigma, { "m", "standard deviation of a compact cluster's centroid" });
@@ -184,10 +192,11 @@ void forEachParam(TrackerParams& p, Get&& get)
 
 /**
  * @brief Per return of @p returns (vehicle frame, vehicle pose @p pose): 1 when it lies on static background, i.e.
- *        its map cell's counter @p zetaAt(map point) is above @p zeta_max (NaN or negative outside the grid: 0).
+ *        @p onBackground(its map point) is true (trackScan(): its map cell's counter ζ is above background_zeta or,
+ *        with step building background, its BetP(C) above background_building).
  */
-template <class ZetaAt>
-void backgroundFlags(const Pose2& pose, const ObstaclePoints& returns, double zeta_max, ZetaAt&& zetaAt,
+template <class OnBackground>
+void backgroundFlags(const Pose2& pose, const ObstaclePoints& returns, OnBackground&& onBackground,
                      std::vector<std::uint8_t>& flags)
 {
   flags.assign(returns.count, 0);
@@ -195,7 +204,7 @@ void backgroundFlags(const Pose2& pose, const ObstaclePoints& returns, double ze
   for (std::size_t i = 0; i < returns.count; ++i)
   {
     const double x = returns.xy[2 * i], y = returns.xy[2 * i + 1];
-    flags[i] = zetaAt(Point2{ pose.x + c * x - s * y, pose.y + s * x + c * y }) > zeta_max;
+    flags[i] = onBackground(Point2{ pose.x + c * x - s * y, pose.y + s * x + c * y }) ? 1 : 0;
   }
 }
 
