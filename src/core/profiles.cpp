@@ -1,5 +1,7 @@
 #include "map_aided_fusion/core/profiles.hpp"
 
+#include <cmath>
+
 namespace map_aided_fusion {
 namespace core {
 
@@ -104,10 +106,16 @@ void carSelfBox(ScanGridParams& p)
   p.self_box_max_y = kCarSelfBoxHalfWidth;
 }
 
+double scanGridCoveringWindow(double window_x, double window_y)
+{
+  return std::ceil(std::hypot(window_x, window_y));
+}
+
 Profile defaultProfile()
 {
   Profile p;
   carSelfBox(p.scan_grid);
+  p.scan_grid.grid_size_x = p.scan_grid.grid_size_y = scanGridCoveringWindow(p.map_grid.size_x, p.map_grid.size_y);
   return p;
 }
 

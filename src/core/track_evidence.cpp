@@ -201,8 +201,15 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
   return out;
 }
 
+float priorBetPBuilding(const PriorWindow& prior, std::size_t i)
+{
+  const float b = prior.building[i], w = prior.wall.empty() ? 0.0f : prior.wall[i];
+  const float omega = std::max(0.0f, 1.0f - b - prior.road[i] - prior.other[i] - w);
+  return b + 0.5f * w + omega / static_cast<float>(FrameMG::kSize);
+}
+
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
-               std::vector<std::uint8_t>& background, const ScanMassGrid* scan)
+               std::vector<std::uint8_t>& background, const ScanMassGrid* scan, const PriorWindow* prior)
 {
   const GridGeometry& g = grid.geometry();
   const MapMassGrid& masses = grid.masses();
@@ -212,7 +219,12 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
   backgroundFlags(pose, returns,
                   [&](Point2 q) {
                     CellIndex c;
-                    if (!g.worldToCell(q, c)) return false;
+                    if (!g.worldToCell(q, c))
+                    {
+                      // Beyond the window: no counter, and the prior's own BetP(C) for the fused one.
+                      if (!p.building_background || !prior || !prior->geometry.worldToCell(q, c)) return false;
+                      return priorBetPBuilding(*prior, prior->geometry.index(c)) > p.background_building;
+                    }
                     const std::size_t i = g.index(c);
                     return masses.zeta(i) > p.background_zeta || (building && betp_c[i] > p.background_building);
                   },

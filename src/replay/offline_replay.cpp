@@ -484,7 +484,7 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
       if (auto c = covariance_sigma.upper_bound(k); c != covariance_sigma.begin()) sigma = std::prev(c)->second;
       const core::PriorWindow* pw = v->use_prior ? v->softener.softened(sigma) : nullptr;
       v->grid.update(v->scan, pose, t, pw, nullptr, &obstacles);
-      if (v->tracker) core::trackScan(*v->tracker, v->grid, t, pose, obstacles, v->background, &v->scan);
+      if (v->tracker) core::trackScan(*v->tracker, v->grid, t, pose, obstacles, v->background, &v->scan, pw);
       auto scoreTracks = [&](const std::vector<eval::ObjectSighting>& sightings) {
         if (!v->tracker || !objects || point_mode) return;
         // Labelled boxes: only tracks where the labels are valid can be judged.

@@ -532,7 +532,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   header.stamp = msg->header.stamp;
   header.frame_id = node_params_.map_frame;
   const auto tracking_start = std::chrono::steady_clock::now();
-  if (tracker_) track(header, stamp, pose, obstacles, scan);
+  if (tracker_) track(header, stamp, pose, obstacles, scan, prior);
   const auto outputs_start = std::chrono::steady_clock::now();
   publish(header, prior);
   const auto end = std::chrono::steady_clock::now();
@@ -605,9 +605,10 @@ void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWind
 }
 
 void FusionWorker::track(const std_msgs::Header& header, double stamp, const core::Pose2& pose,
-                          const core::ObstaclePoints& returns, const core::ScanMassGrid& scan)
+                          const core::ObstaclePoints& returns, const core::ScanMassGrid& scan,
+                          const core::PriorWindow* prior)
 {
-  core::trackScan(*tracker_, grid_, stamp, pose, returns, background_, &scan);
+  core::trackScan(*tracker_, grid_, stamp, pose, returns, background_, &scan, prior);
   if (tracker_->counts().resets > tracker_resets_seen_)
   {
     tracker_resets_seen_ = tracker_->counts().resets;

@@ -590,56 +590,63 @@ TEST(MotionSteps, MarkHiddenFlagsTheInteriorCellsTheScanDidNotSeeFree)
   }
 }
 
-// Step building background: a facade the map has (prior B) and an unmapped box, both seen for the first time. With
-// the step, the facade's returns lie on static background from that first scan (BetP(C) > 0.5), the box's do not;
-// without it, neither does (their counter ζ has grown by one δ_inc only).
+// Step building background: two facades the map has (prior B), one inside the MapGrid's 100 m window and one 65 m
+// away, beyond it but inside the default 142 m ScanGrid, and an unmapped box, all seen for the first time. With
+// the step, the near facade's returns lie on static background from that first scan (the grid's BetP(C) > 0.5), the
+// far one's too when trackScan() is given the prior (its own BetP(C): the window has no cell there), the box's never;
+// without the step, none does (their counter ζ has grown by one δ_inc only).
 TEST(MotionSteps, BuildingBackgroundFlagsTheReturnsOnAMappedFacadeFromItsFirstScan)
 {
   World world;
-  world.boxes.push_back({ 20.0, -10.0, 21.0, 10.0, 3.0 });  // the mapped facade
-  world.boxes.push_back({ -15.0, -1.0, -13.0, 1.0, 1.5 });  // an unmapped box
+  world.max_range = 80.0;
+  world.boxes.push_back({ 20.0, -10.0, 21.0, 10.0, 3.0 });   // the mapped facade in the window
+  world.boxes.push_back({ 55.0, -40.0, 56.0, -30.0, 3.0 });  // the mapped facade beyond the window
+  world.boxes.push_back({ -15.0, -1.0, -13.0, 1.0, 1.5 });   // an unmapped box
   PriorWindow prior(GridGeometry::centred(200.0, 200.0, 0.5));
   const PriorConfidence beta;
   for (std::size_t i = 0; i < prior.building.size(); ++i)
   {
     const Point2 p = prior.geometry.cellCentre(prior.geometry.cellOf(i));
-    const bool facade = p.x > 19.5 && p.x < 21.5 && p.y > -10.5 && p.y < 10.5;
+    const bool facade = (p.x > 19.5 && p.x < 21.5 && p.y > -10.5 && p.y < 10.5) ||
+                        (p.x > 54.5 && p.x < 56.5 && p.y > -40.5 && p.y < -29.5);
     const auto m = priorMass(facade ? PriorClass::kBuilding : PriorClass::kOther, beta);
     prior.building[i] = static_cast<float>(m[FrameMG::kBuilding]);
     prior.other[i] = static_cast<float>(m[FrameMG::kOther]);
   }
   const Pose2 pose{ 0.0, 0.0, 0.0 };
   for (const bool step : { true, false })
-  {
-    Profile profile = defaultProfile();
-    profile.tracker.building_background = step;
-    core::Run run(profile);
-    run.step(world, pose, &prior);
-    Tracker tracker(profile.tracker);
-    std::vector<std::uint8_t> background;
-    const ObstaclePoints returns = run.builder.obstaclePoints();
-    trackScan(tracker, run.grid, kScanPeriod, pose, returns, background, &run.scan);
-    ASSERT_EQ(background.size(), returns.count);
-    int facade = 0, facade_flagged = 0, box = 0, box_flagged = 0;
-    for (std::size_t i = 0; i < returns.count; ++i)
+    for (const bool with_prior : { true, false })
     {
-      const double x = returns.xy[2 * i];
-      if (x > 19.0)
+      Profile profile = defaultProfile();
+      profile.tracker.building_background = step;
+      core::Run run(profile);
+      run.step(world, pose, &prior);
+      CellIndex beyond;
+      ASSERT_FALSE(run.grid.geometry().worldToCell(Point2{ 55.0, -35.0 }, beyond)) << "the far facade lies beyond the window";
+      Tracker tracker(profile.tracker);
+      std::vector<std::uint8_t> background;
+      const ObstaclePoints returns = run.builder.obstaclePoints();
+      trackScan(tracker, run.grid, kScanPeriod, pose, returns, background, &run.scan, with_prior ? &prior : nullptr);
+      ASSERT_EQ(background.size(), returns.count);
+      int near = 0, near_flagged = 0, far = 0, far_flagged = 0, box = 0, box_flagged = 0;
+      for (std::size_t i = 0; i < returns.count; ++i)
       {
-        ++facade;
-        facade_flagged += background[i];
+        const double x = returns.xy[2 * i];
+        int& n = x > 54.0 ? far : x > 19.0 ? near : box;
+        int& f = x > 54.0 ? far_flagged : x > 19.0 ? near_flagged : box_flagged;
+        if (x > 19.0 || x < -12.0)
+        {
+          ++n;
+          f += background[i];
+        }
       }
-      else if (x < -12.0)
-      {
-        ++box;
-        box_flagged += background[i];
-      }
+      ASSERT_GT(near, 50) << "the near facade is seen";
+      ASSERT_GT(far, 20) << "the far facade is seen";
+      ASSERT_GT(box, 10) << "the box is seen";
+      EXPECT_EQ(near_flagged, step ? near : 0) << "step " << step << " prior " << with_prior;
+      EXPECT_EQ(far_flagged, step && with_prior ? far : 0) << "step " << step << " prior " << with_prior;
+      EXPECT_EQ(box_flagged, 0) << "step " << step << " prior " << with_prior;
     }
-    ASSERT_GT(facade, 50) << "the facade is seen";
-    ASSERT_GT(box, 10) << "the box is seen";
-    EXPECT_EQ(facade_flagged, step ? facade : 0) << "step " << step;
-    EXPECT_EQ(box_flagged, 0) << "step " << step;
-  }
 }
 
 }  // namespace core

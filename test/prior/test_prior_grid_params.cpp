@@ -227,9 +227,10 @@ TEST(Profiles, IbeoScanGridDiffersFromTheDefaultOnlyWhereTheSensorNeedsIt)
   std::set<std::string> differ;
   for (const auto& kv : a)
     if (b.at(kv.first) != kv.second) differ.insert(kv.first);
-  // The self box too: a sensor on the front bumper sees none of its vehicle.
-  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "ground_model", "relative_height_limit",
-                                            "self_box_max_x", "self_box_max_y", "self_box_min_x", "self_box_min_y" }));
+  // The self box too: a sensor on the front bumper sees none of its vehicle; and the paper's 100 m grid.
+  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "grid_size_x", "grid_size_y", "ground_model",
+                                            "relative_height_limit", "self_box_max_x", "self_box_max_y",
+                                            "self_box_min_x", "self_box_min_y" }));
   EXPECT_EQ(ibeo.groundModel(), core::GroundModel::kFlat);
   EXPECT_EQ(ibeo.grid_resolution, 0.5) << "the paper's cells";
   EXPECT_EQ(ibeo.grid_size_x, 100.0) << "the paper's window";

@@ -45,9 +45,14 @@ const std::vector<AddedStep>& addedSteps();
 /// The paper's method: every added step off, the paper's α, β, δ, γ, μ.
 Profile paperProfile();
 
-/// This package's default (the files of config/): the structs' defaults, and the self box of a passenger car with
-/// its lidar on the roof (carSelfBox()).
+/// This package's default (the files of config/): the structs' defaults, the self box of a passenger car with
+/// its lidar on the roof (carSelfBox()) and a ScanGrid that covers the MapGrid's window (scanGridCoveringWindow()).
 Profile defaultProfile();
+
+/// Side of a square ScanGrid (vehicle frame, m) that covers a MapGrid window of @p window_x × @p window_y (map
+/// frame, centred on the vehicle) whatever the heading: its diagonal, rounded up to a metre (142 m for 100 m).
+/// The paper's 100 m ScanGrid leaves the window's corners unseen when the heading is not along an axis.
+double scanGridCoveringWindow(double window_x, double window_y);
 
 /// Sets @p p's self box to a passenger car's with its lidar on the roof, base_link on the ground under the lidar:
 /// x in [−2.7, 2.7] m, y in [−1.7, 1.7] m (KITTI's car returns its own roof edges and mirrors up to 1.6 m beside

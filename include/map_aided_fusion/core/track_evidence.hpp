@@ -61,14 +61,21 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
 void markHidden(std::vector<CellMotion>& cells, const GridGeometry& geometry, const ScanMassGrid& scan,
                 const Pose2& pose);
 
+/// BetP(C) of the prior mass function of cell @p i of @p prior: m(B) + m(W)/2 + m(Ω)/5.
+float priorBetPBuilding(const PriorWindow& prior, std::size_t i);
+
 /**
- * @brief One scan of tracking after @p grid's update(): flags the returns on static background (the grid's counter ζ
- *        above background_zeta, backgroundFlags()), updates @p tracker with the scan's ScanGrid @p scan (vehicle
- *        frame; the free space of step free-space check, nullptr: none), and applies its evidence to @p grid
- *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan.
+ * @brief One scan of tracking after @p grid's update(): flags the returns on static background (backgroundFlags():
+ *        the grid's counter ζ above background_zeta or, with step building background, its BetP(C) above
+ *        background_building; beyond the grid's window, where it has neither, @p prior's own BetP(C),
+ *        priorBetPBuilding(), when given), updates @p tracker with the scan's ScanGrid @p scan (vehicle frame; the
+ *        free space of step free-space check, nullptr: none), and applies its evidence to @p grid
+ *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan; @p prior is
+ *        the prior the grid's update() fused (nullptr: none).
  */
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
-               std::vector<std::uint8_t>& background, const ScanMassGrid* scan = nullptr);
+               std::vector<std::uint8_t>& background, const ScanMassGrid* scan = nullptr,
+               const PriorWindow* prior = nullptr);
 
 }  // namespace core
 }  // namespace map_aided_fusion

@@ -128,7 +128,7 @@ private:
   /// Updates the tracker with the scan's obstacle returns, applies its motion evidence to the MapGrid (step "track
   /// evidence") and publishes `tracks` and `tracks/markers`.
   void track(const std_msgs::Header& header, double stamp, const core::Pose2& pose, const core::ObstaclePoints& returns,
-             const core::ScanMassGrid& scan);
+             const core::ScanMassGrid& scan, const core::PriorWindow* prior);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
