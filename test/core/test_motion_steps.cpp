@@ -8,6 +8,7 @@
 
 #include "map_aided_fusion/core/fusion.hpp"
 #include "map_aided_fusion/core/map_grid.hpp"
+#include "map_aided_fusion/core/pignistic.hpp"
 #include "map_aided_fusion/core/prior.hpp"
 #include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
@@ -556,6 +557,26 @@ TEST(MotionSteps, SmallMoverCellsAlsoGiveTheirSetsHoldingN)
   EXPECT_NEAR(after[nsv], 0.5 * before[nsv], 1e-6);
   EXPECT_EQ(massesOf(without.grid, i)[nsv], before[nsv]) << "without the flag {N, S, V} stays";
   EXPECT_EQ(with.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
+}
+
+// priorBetPBuilding() is BetP(C) of the prior's mass function (pignistic() of PriorWindow::cell()), on cells of every
+// kind: building, road, other, a wall outline, a softened edge and Ω.
+TEST(MotionSteps, PriorBetPBuildingIsThePignisticOfThePriorCell)
+{
+  PriorWindow prior(GridGeometry::centred(3.0, 2.0, 0.5));  // 6 × 4 cells
+  const float cells[][4] = { { 0.9f, 0.0f, 0.0f, 0.0f }, { 0.0f, 0.9f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.8f, 0.0f },
+                             { 0.0f, 0.0f, 0.0f, 0.9f }, { 0.45f, 0.3f, 0.1f, 0.05f }, { 0.0f, 0.0f, 0.0f, 0.0f } };
+  for (std::size_t i = 0; i < 6; ++i)
+  {
+    prior.building[i] = cells[i][0];
+    prior.road[i] = cells[i][1];
+    prior.other[i] = cells[i][2];
+    prior.wall[i] = cells[i][3];
+    const double want = pignistic(prior.cell(i))[1];  // element 1: C
+    EXPECT_NEAR(priorBetPBuilding(prior, i), want, 1e-6) << "cell " << i;
+  }
+  EXPECT_NEAR(priorBetPBuilding(prior, 5), 1.0 / FrameMG::kSize, 1e-7) << "Ω shares its mass";
+  EXPECT_NEAR(priorBetPBuilding(prior, 3), 0.45 + 0.1 / FrameMG::kSize, 1e-6) << "W = {F, C} gives C half";
 }
 
 TEST(MotionSteps, MarkHiddenFlagsTheInteriorCellsTheScanDidNotSeeFree)
