@@ -50,25 +50,6 @@ void addBoxInterior(const Measurement& m, const GridGeometry& g, CellMotion c, s
     }
 }
 
-/// Step "hidden length": @p m's box in its heading's axes, extended away from the sensor along @p heading to
-/// @p length when it is at least @p end_width wide across the heading and shallower than @p length along it; nothing
-/// otherwise.
-std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading, double length, double end_width)
-{
-  if (!m.has_sensor || !(length > 0.0)) return std::nullopt;
-  const Eigen::Vector2d along(std::cos(heading), std::sin(heading)), across(-along.y(), along.x());
-  const AxisView u = viewAlong(m, along), v = viewAlong(m, across);
-  if (u.hi - u.lo >= length || v.hi - v.lo < end_width) return std::nullopt;
-  const bool behind = (m.sensor.x - m.centroid.x) * along.x() + (m.sensor.y - m.centroid.y) * along.y() < 0.0;
-  Measurement e = m;
-  e.yaw = heading;
-  e.lo_u = behind ? u.lo : u.hi - length;
-  e.hi_u = behind ? u.lo + length : u.hi;
-  e.lo_v = v.lo;
-  e.hi_v = v.hi;
-  return e;
-}
-
 /// Step "small box": @p m's box in the axes of the line of sight, grown to @p size along it (away from the sensor:
 /// the rays end on the near side) and across it (on both sides); nothing when it already is that large.
 std::optional<Measurement> smallMoverBox(const Measurement& m, double size)
@@ -93,28 +74,9 @@ double heading(const Track& t) { return std::atan2(t.x(3), t.x(2)); }
 
 }  // namespace
 
-ObjectBox ownBox(const Track& t) { return ObjectBox{ t.position(), t.extent_yaw, t.extent_length, t.extent_width }; }
-
 ObjectBox reportedBox(const Track& t, const Tracker& tracker)
 {
-  ObjectBox b = ownBox(t);
-  const TrackerParams& p = tracker.params();
-  const std::vector<Measurement>& measurements = tracker.measurements();
-  if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0) || t.measurement < 0 ||
-      t.measurement >= static_cast<int>(measurements.size()))
-    return b;
-  const Measurement& m = measurements[t.measurement];
-  const std::optional<Measurement> e = hiddenLengthBox(m, heading(t), p.evidence_hidden_length, p.evidence_end_width);
-  if (!e) return b;
-  const double cu = 0.5 * (e->lo_u + e->hi_u), cv = 0.5 * (e->lo_v + e->hi_v);
-  const double c = std::cos(e->yaw), s = std::sin(e->yaw);
-  const Point2 followed = referencePoint(t, m);
-  b.centre = Point2{ t.x(0) + m.centroid.x + cu * c - cv * s - followed.x,
-                     t.x(1) + m.centroid.y + cu * s + cv * c - followed.y };
-  b.yaw = e->yaw;
-  b.length = e->hi_u - e->lo_u;
-  b.width = e->hi_v - e->lo_v;
-  return b;
+  return objectBox(t, tracker.params(), tracker.measurements());
 }
 
 std::vector<ObjectBox> reportedBoxes(const Tracker& tracker)
@@ -170,14 +132,19 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     c.take_n = c.motion == CellClass::kMoving && p.evidence_small_size > 0.0 &&
                t.extent_length <= p.evidence_small_size && t.extent_width <= p.evidence_small_size;
     const std::size_t first = out.size();
-    for (const int i : measurements[t.measurement].returns)
-    {
-      if (i < 0 || i >= static_cast<int>(points.size())) continue;
-      CellIndex ci;
-      if (!g.worldToCell(points[i], ci)) continue;
-      c.cell = g.index(ci);
-      out.push_back(c);
-    }
+    auto addReturns = [&](int measurement) {
+      if (measurement < 0 || measurement >= static_cast<int>(measurements.size())) return;
+      for (const int i : measurements[measurement].returns)
+      {
+        if (i < 0 || i >= static_cast<int>(points.size())) continue;
+        CellIndex ci;
+        if (!g.worldToCell(points[i], ci)) continue;
+        c.cell = g.index(ci);
+        out.push_back(c);
+      }
+    };
+    addReturns(t.measurement);
+    for (const int f : t.fragments) addReturns(f);
     // One entry per cell and track.
     std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
               [](const CellMotion& a, const CellMotion& b) { return a.cell < b.cell; });

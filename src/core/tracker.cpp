@@ -28,6 +28,8 @@ constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
+// Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
+const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
 
 std::int64_t cellKey(std::int64_t x, std::int64_t y) { return (x << 32) ^ (y & 0xffffffffLL); }
 
@@ -315,6 +317,51 @@ Point2 referencePoint(const Track& t, const Measurement& m)
   return Point2{ r.x(), r.y() };
 }
 
+ObjectBox ownBox(const Track& t) { return ObjectBox{ t.position(), t.extent_yaw, t.extent_length, t.extent_width }; }
+
+bool inBox(const ObjectBox& box, Point2 p, double margin)
+{
+  const double c = std::cos(box.yaw), s = std::sin(box.yaw), dx = p.x - box.centre.x, dy = p.y - box.centre.y;
+  return std::abs(dx * c + dy * s) <= 0.5 * box.length + margin && std::abs(-dx * s + dy * c) <= 0.5 * box.width + margin;
+}
+
+std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading, double length, double end_width)
+{
+  if (!m.has_sensor || !(length > 0.0)) return std::nullopt;
+  const Eigen::Vector2d along(std::cos(heading), std::sin(heading)), across(-along.y(), along.x());
+  const AxisView u = viewAlong(m, along), v = viewAlong(m, across);
+  if (u.hi - u.lo >= length || v.hi - v.lo < end_width) return std::nullopt;
+  const bool behind = (m.sensor.x - m.centroid.x) * along.x() + (m.sensor.y - m.centroid.y) * along.y() < 0.0;
+  Measurement e = m;
+  e.yaw = heading;
+  e.lo_u = behind ? u.lo : u.hi - length;
+  e.hi_u = behind ? u.lo + length : u.hi;
+  e.lo_v = v.lo;
+  e.hi_v = v.hi;
+  return e;
+}
+
+ObjectBox objectBox(const Track& t, const TrackerParams& p, const std::vector<Measurement>& measurements)
+{
+  ObjectBox b = ownBox(t);
+  if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0) || t.measurement < 0 ||
+      t.measurement >= static_cast<int>(measurements.size()))
+    return b;
+  const Measurement& m = measurements[t.measurement];
+  const std::optional<Measurement> e =
+      hiddenLengthBox(m, std::atan2(t.x(3), t.x(2)), p.evidence_hidden_length, p.evidence_end_width);
+  if (!e) return b;
+  const double cu = 0.5 * (e->lo_u + e->hi_u), cv = 0.5 * (e->lo_v + e->hi_v);
+  const double c = std::cos(e->yaw), s = std::sin(e->yaw);
+  const Point2 followed = referencePoint(t, m);
+  b.centre = Point2{ t.x(0) + m.centroid.x + cu * c - cv * s - followed.x,
+                     t.x(1) + m.centroid.y + cu * s + cv * c - followed.y };
+  b.yaw = e->yaw;
+  b.length = e->hi_u - e->lo_u;
+  b.width = e->hi_v - e->lo_v;
+  return b;
+}
+
 double Track::speedSigma() const
 {
   const Eigen::Matrix2d pv = P.bottomRightCorner<2, 2>();
@@ -531,6 +578,49 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   update(stamp, own_measurements_);
 }
 
+void Tracker::dropDuplicates(std::vector<Track>& tracks, double stamp)
+{
+  std::vector<std::size_t> moving;
+  for (std::size_t j = 0; j < tracks.size(); ++j)
+    if (tracks[j].reported() && tracks[j].motion == TrackMotion::kMoving && tracks[j].last_hit >= stamp &&
+        tracks[j].measurement >= 0)
+      moving.push_back(j);
+  if (moving.size() < 2) return;
+  // The tracks with more hits (then the older ids) keep their objects.
+  std::sort(moving.begin(), moving.end(), [&](std::size_t a, std::size_t b) {
+    return tracks[a].hits != tracks[b].hits ? tracks[a].hits > tracks[b].hits : tracks[a].id < tracks[b].id;
+  });
+  std::vector<ObjectBox> boxes;
+  boxes.reserve(moving.size());
+  for (std::size_t j : moving) boxes.push_back(objectBox(tracks[j], params_, measurements_));
+  std::vector<char> dropped(tracks.size(), 0);
+  for (std::size_t a = 0; a < moving.size(); ++a)
+  {
+    if (dropped[moving[a]]) continue;
+    Track& keep = tracks[moving[a]];
+    for (std::size_t b = a + 1; b < moving.size(); ++b)
+    {
+      const Track& other = tracks[moving[b]];
+      if (dropped[moving[b]] || !inBox(boxes[a], boxes[b].centre, params_.fragment_margin)) continue;
+      if (keep.velocity().x * other.velocity().x + keep.velocity().y * other.velocity().y <
+          kDuplicateMinCosine * keep.speed() * other.speed())
+        continue;
+      dropped[moving[b]] = 1;
+      keep.fragments.push_back(tracks[moving[b]].measurement);
+      ++counts_.duplicates;
+      ++counts_.tracks_deleted;
+    }
+  }
+  std::size_t out = 0;
+  for (std::size_t j = 0; j < tracks.size(); ++j)
+  {
+    if (dropped[j]) continue;
+    if (out != j) tracks[out] = std::move(tracks[j]);
+    ++out;
+  }
+  tracks.resize(out);
+}
+
 void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
 {
   ++counts_.scans;
@@ -568,6 +658,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
   {
     predict(t, dt);
     t.measurement = -1;
+    t.fragments.clear();
   }
 
   // Gated global assignment on the Mahalanobis distance of the innovation.
@@ -634,31 +725,27 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     decideMotion(t, stamp);
     kept.push_back(std::move(t));
   }
+  if (params_.duplicates) dropDuplicates(kept, stamp);
   const double v2 = params_.initial_speed_sigma * params_.initial_speed_sigma;
   const std::size_t seen_tracks = kept.size();
-  // Step fragments: the box of a moving track seen this scan, grown by the margin, holds the centroid of @p z.
-  auto fragment = [&](const Measurement& z) {
-    if (!params_.fragments) return false;
-    const double grow = params_.fragment_margin;
+  // Step fragments: the box of a moving track seen this scan (with step duplicates, its object box), grown by the
+  // margin, holds the centroid of a cluster no track took; with step duplicates the cluster is that track's piece.
+  std::vector<std::pair<std::size_t, ObjectBox>> moving_boxes;
+  if (params_.fragments)
     for (std::size_t j = 0; j < seen_tracks; ++j)
-    {
-      const Track& o = kept[j];
-      if (o.motion != TrackMotion::kMoving || o.last_hit < stamp) continue;
-      const double c = std::cos(o.extent_yaw), sn = std::sin(o.extent_yaw);
-      const double dx = z.centroid.x - o.x(0), dy = z.centroid.y - o.x(1);
-      if (std::abs(dx * c + dy * sn) <= 0.5 * o.extent_length + grow &&
-          std::abs(-dx * sn + dy * c) <= 0.5 * o.extent_width + grow)
-        return true;
-    }
-    return false;
-  };
+      if (kept[j].motion == TrackMotion::kMoving && kept[j].last_hit >= stamp)
+        moving_boxes.emplace_back(j, params_.duplicates ? objectBox(kept[j], params_, measurements_) : ownBox(kept[j]));
   for (std::size_t m = 0; m < measurements_.size(); ++m)
   {
     if (used[m]) continue;
     const Measurement& z = measurements_[m];
-    if (fragment(z))
+    const auto owner = std::find_if(moving_boxes.begin(), moving_boxes.end(), [&](const auto& jb) {
+      return inBox(jb.second, z.centroid, params_.fragment_margin);
+    });
+    if (owner != moving_boxes.end())
     {
       ++counts_.fragments;
+      if (params_.duplicates) kept[owner->first].fragments.push_back(static_cast<int>(m));
       continue;
     }
     Track t;

@@ -731,6 +731,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("tracker resets", c.resets);
     status.add("tracks deleted (non-finite or too fast)", c.rejected_tracks);
     status.add("clusters not tracked (fragments of a moving track)", c.fragments);
+    status.add("tracks deleted (duplicates of a moving track)", c.duplicates);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }
 }

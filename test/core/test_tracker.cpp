@@ -652,9 +652,10 @@ TEST(Tracker, FragmentsOfAMovingTrackStartNoTrack)
   EXPECT_EQ(beside.tracks()[0].motion, TrackMotion::kMoving);
   EXPECT_EQ(beside.counts().fragments, 6u) << "one per scan from scan 6";
   EXPECT_EQ(beside.counts().tracks_created, 1u);
-  // The step off: a second track.
+  // The step off (and step duplicates, which deletes the second track once both move): a second track.
   TrackerParams off = p;
   off.fragments = false;
+  off.duplicates = false;
   const Tracker without = carWithACompanion(off, 8.0, 0.8);
   EXPECT_EQ(without.tracks().size(), 2u);
   EXPECT_EQ(without.counts().fragments, 0u);
@@ -848,6 +849,75 @@ TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
     EXPECT_FALSE(without.empty());
     EXPECT_EQ(cellsIn(without, g, face + margin, 1e9, 5.0), 0u) << (length_zero ? "length 0" : "step off");
   }
+}
+
+namespace {
+
+/// A car's rear face (1.8 m wide across y = 5, two rows of returns every 0.1 m) driving away from the sensor at the
+/// origin along +x at 8 m/s for 14 scans from x = 10, and from scan 1 on (before the face's track is confirmed) a
+/// block of 4 × 4 returns (0.3 × 0.3 m, on
+/// y = 5) @p ahead m beyond the face that slides back by 0.1 m a scan (7 m/s: a lidar ring along the roof when
+/// @p ahead is within the car). @p ring_cell receives the cell of @p g under the block's centre in the last scan.
+Tracker faceAndRing(const TrackerParams& params, double ahead, const GridGeometry& g, std::size_t& ring_cell)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < 14; ++k)
+  {
+    const double face_x = 10.0 + 0.8 * k;
+    std::vector<Point2> points;
+    for (double y = 4.1; y <= 5.9 + 1e-9; y += 0.1)
+      for (const double dx : { 0.0, 0.05 }) points.push_back(Point2{ face_x + dx, y });
+    const double ring_x = face_x + ahead - 0.1 * k;
+    if (k >= 1)
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) points.push_back(Point2{ ring_x - 0.15 + 0.1 * i, 5.0 - 0.15 + 0.1 * j });
+    ring_cell = g.index(g.cellAt(Point2{ ring_x, 5.0 }));
+    const std::vector<float> xy = flatten(points);
+    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  }
+  return tracker;
+}
+
+}  // namespace
+
+TEST(Tracker, DuplicatesLeaveOneTrackPerObjectAndTheirReturnsTakeItsMotion)
+{
+  const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
+  TrackerParams p;
+  ASSERT_TRUE(p.duplicates);
+  ASSERT_DOUBLE_EQ(p.fragment_margin, 1.0);
+  std::size_t ring_cell = 0;
+  // The block 2.5 m beyond the face lies in the car's object box (step hidden length: 4 m away from the sensor
+  // behind its face): its track is deleted once both move, and from then on the block is the car's fragment, outside
+  // the face's own box (0.05 m deep) and its margin.
+  const Tracker one = faceAndRing(p, 2.5, g, ring_cell);
+  ASSERT_EQ(one.tracks().size(), 1u);
+  const Track& car = one.tracks()[0];
+  EXPECT_EQ(car.id, 1u) << "the track with more hits keeps the object";
+  EXPECT_EQ(car.motion, TrackMotion::kMoving);
+  EXPECT_EQ(one.counts().duplicates, 1u);
+  EXPECT_EQ(one.counts().tracks_created, 2u) << "the block starts no track after its duplicate is deleted";
+  EXPECT_GT(one.counts().fragments, 0u);
+  ASSERT_EQ(car.fragments.size(), 1u) << "the block, in the last scan";
+  EXPECT_EQ(one.measurements()[car.fragments[0]].points, 16);
+  // Its returns take the car's motion and β, as the car's own returns (not as box cells).
+  const std::vector<CellMotion> cells = trackEvidence(one, g);
+  const auto ring = std::find_if(cells.begin(), cells.end(), [&](const CellMotion& c) { return c.cell == ring_cell; });
+  ASSERT_NE(ring, cells.end());
+  EXPECT_EQ(ring->motion, CellClass::kMoving);
+  EXPECT_FALSE(ring->interior);
+  EXPECT_FLOAT_EQ(ring->weight, static_cast<float>(p.evidence_weight * motionProbability(car, p)));
+  // The step off: two moving tracks on one car.
+  TrackerParams off = p;
+  off.duplicates = false;
+  const Tracker two = faceAndRing(off, 2.5, g, ring_cell);
+  ASSERT_EQ(two.tracks().size(), 2u);
+  for (const Track& t : two.tracks()) EXPECT_EQ(t.motion, TrackMotion::kMoving);
+  EXPECT_EQ(two.counts().duplicates, 0u);
+  // 6.5 m beyond the face (a car ahead: past the 4 m box and its 1 m margin): its own track.
+  const Tracker ahead = faceAndRing(p, 6.5, g, ring_cell);
+  EXPECT_EQ(ahead.tracks().size(), 2u);
+  EXPECT_EQ(ahead.counts().duplicates, 0u);
 }
 
 TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)

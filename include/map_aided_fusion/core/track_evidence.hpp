@@ -22,25 +22,7 @@ namespace core {
 /// than stopped_speed (stopped); 0 for a track whose motion is not decided.
 double motionProbability(const Track& track, const TrackerParams& params);
 
-/// What a track reports as its object (the tracks topic, the scoring of evaluate): centre, heading and extents.
-struct ObjectBox
-{
-  Point2 centre;
-  double yaw = 0.0;     ///< rad, map frame
-  double length = 0.0;  ///< m, along yaw
-  double width = 0.0;   ///< m, across it
-};
-
-/// The track's own box: its position with Track::extent_yaw, extent_length and extent_width.
-ObjectBox ownBox(const Track& t);
-
-/**
- * @brief The object the track @p t of @p tracker reports: its position with its box (Track::extent_yaw,
- *        extent_length, extent_width); with step hidden centre (TrackerParams::hidden_centre and
- *        evidence_hidden_length > 0), a moving track seen end-on in its last measurement reports the box of step
- *        hidden length along its heading, its position moved by as much as that box's centre lies from the point
- *        the track follows (referencePoint()).
- */
+/// objectBox() of the track @p t of @p tracker, with its last scan's measurements.
 ObjectBox reportedBox(const Track& t, const Tracker& tracker);
 
 /// reportedBox() of every track of @p tracker, in the order of Tracker::tracks().
@@ -48,7 +30,8 @@ std::vector<ObjectBox> reportedBoxes(const Tracker& tracker);
 
 /**
  * @brief The cells of @p geometry holding the returns of the last scan of every reported track associated in that
- *        scan, with the track's motion and β. Empty when evidence_weight is 0 or the tracker was given measurements
+ *        scan (its measurement's and, with step duplicates, its fragments', Track::fragments), with the track's
+ *        motion and β. Empty when evidence_weight is 0 or the tracker was given measurements
  *        without returns.
  */
 std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry& geometry);

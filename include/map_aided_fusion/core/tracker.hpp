@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -58,6 +59,15 @@ struct TrackerParams
   /// fragment_margin on every side, starts no track (and is counted).
   bool fragments = true;
   double fragment_margin = 1.0;      ///< m
+  /// Step "duplicates": one object can still hold several moving tracks: clusters that started their track before
+  /// the object's own track moved, the returns of a lidar ring that slides along a car's roof at a fixed range from
+  /// the sensor (at the vehicle's speed), a van's side sampled column by column at a grazing angle. A moving track
+  /// seen this scan whose object box (objectBox()) has its centre in the object box of a moving track with more hits
+  /// seen this scan, grown by fragment_margin, and that moves within 60° of its heading (two objects passing each
+  /// other do not), is a duplicate of it: it is deleted (and counted). Its cluster, and
+  /// with this step every fragment, is then a piece of the other's object: step fragments tests the object box, and
+  /// the pieces' returns take the track's motion (Track::fragments, step track evidence).
+  bool duplicates = true;
   double max_coast_time = 0.5;       ///< s without an association before a confirmed track is deleted
   double moving_speed = 0.5;         ///< m/s: moving when speed − motion_sigmas · σ(speed) is above this
   double motion_sigmas = 1.5;        ///< how many standard deviations the speed must clear
@@ -157,6 +167,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_max_gate_distance", p.max_gate_distance, { "m", "no association farther than this, whatever the covariance" });
   get("tracker_confirm_hits", p.confirm_hits, { "scans", "consecutive associations that confirm a tentative track" });
   get("tracker_fragments", p.fragments, { "", "step fragments: a cluster in the box of a moving track seen this scan (grown by tracker_fragment_margin) starts no track" });
+  get("tracker_duplicates", p.duplicates, { "", "step duplicates: a moving track whose object box centre lies in the object box of a moving track with more hits (grown by tracker_fragment_margin), moving within 60° of its heading, is deleted; its cluster and the fragments take that track's motion" });
   get("tracker_fragment_margin", p.fragment_margin, { "m", "how far beyond a moving track's box a cluster is a fragment of it (step fragments)" });
   get("tracker_max_coast_time", p.max_coast_time, { "s", "time without an association before a confirmed track is deleted" });
   get("tracker_moving_speed", p.moving_speed, { "m/s", "moving when speed − motion_sigmas·σ(speed) is above this" });
@@ -298,6 +309,9 @@ struct Track
   double yaw = 0.0, length = 0.0, width = 0.0;  ///< of the last associated cluster
   /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
   double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;
+  /// Measurements of the last scan (Tracker::measurements()) that are pieces of its object besides its own: with step
+  /// duplicates, the fragments it kept from starting a track and the clusters of its duplicates.
+  std::vector<int> fragments;
   int hits = 0;                                 ///< associations
   int measurement = -1;                         ///< its measurement of the last scan (Tracker::measurements()), or −1
   int consecutive_hits = 0;
@@ -328,6 +342,7 @@ struct TrackerCounts
   std::uint64_t resets = 0;             ///< every track dropped: a pose or time jump
   std::uint64_t rejected_tracks = 0;    ///< deleted for a non-finite state or an implausible speed
   std::uint64_t fragments = 0;          ///< clusters that started no track: fragments of a moving track (step fragments)
+  std::uint64_t duplicates = 0;         ///< moving tracks deleted as duplicates of another (step duplicates)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
@@ -338,6 +353,36 @@ struct TrackerCounts
  *        otherwise the middle of the cluster's extent. Without a sensor position, or a box, the centroid.
  */
 Point2 referencePoint(const Track& t, const Measurement& m);
+
+/// What a track reports as its object (the tracks topic, the scoring of evaluate): centre, heading and extents.
+struct ObjectBox
+{
+  Point2 centre;
+  double yaw = 0.0;     ///< rad, map frame
+  double length = 0.0;  ///< m, along yaw
+  double width = 0.0;   ///< m, across it
+};
+
+/// The track's own box: its position with Track::extent_yaw, extent_length and extent_width.
+ObjectBox ownBox(const Track& t);
+
+/// True when @p p lies in @p box grown by @p margin (m) on every side.
+bool inBox(const ObjectBox& box, Point2 p, double margin);
+
+/**
+ * @brief Step "hidden length": @p m's box in the axes of @p heading (rad, map frame), extended away from the sensor
+ *        along the heading to @p length when it is at least @p end_width wide across the heading and shallower than
+ *        @p length along it (a vehicle seen end-on); nothing otherwise, or without a sensor position.
+ */
+std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading, double length, double end_width);
+
+/**
+ * @brief The object the track @p t reports, with its last scan's @p measurements: its position with its box
+ *        (ownBox()); with step hidden centre (TrackerParams::hidden_centre and evidence_hidden_length > 0), a moving
+ *        track seen end-on in its last measurement reports the box of step hidden length along its heading, its
+ *        position moved by as much as that box's centre lies from the point the track follows (referencePoint()).
+ */
+ObjectBox objectBox(const Track& t, const TrackerParams& params, const std::vector<Measurement>& measurements);
 
 /// The multi-object tracker.
 class Tracker
@@ -381,6 +426,9 @@ private:
   bool fastEnough(const Track& t, double sigmas) const;
   /// Step small free space: @p t is checked with free_space_small_margin.
   bool smallWalker(const Track& t) const;
+  /// Step duplicates: deletes from @p tracks the duplicates of moving tracks seen at @p stamp; their clusters become
+  /// the kept tracks' fragments.
+  void dropDuplicates(std::vector<Track>& tracks, double stamp);
 
   TrackerParams params_;
   std::vector<Track> tracks_;
