@@ -106,6 +106,7 @@ void BM_TrackerScan(benchmark::State& state)
   TrackerParams params;
   params.free_space_check = state.range(1) != 0;
   params.open_ends = state.range(2) != 0;
+  params.duplicates = state.range(3) != 0;
   Tracker tracker(params);
   int k = 0;
   for (auto _ : state)
@@ -120,10 +121,11 @@ void BM_TrackerScan(benchmark::State& state)
 }  // namespace
 
 BENCHMARK(BM_TrackerScan)
-    ->ArgNames({ "n", "free_space_check", "open_ends" })
-    ->Args({ 200, 0, 0 })
-    ->Args({ 200, 1, 0 })
-    ->Args({ 200, 1, 1 })
+    ->ArgNames({ "n", "free_space_check", "open_ends", "duplicates" })
+    ->Args({ 200, 0, 0, 0 })
+    ->Args({ 200, 1, 0, 0 })
+    ->Args({ 200, 1, 1, 0 })
+    ->Args({ 200, 1, 1, 1 })
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TrackerUpdate)->Arg(200)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ClusterReturns)->Arg(200)->Unit(benchmark::kMicrosecond);

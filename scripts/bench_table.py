@@ -42,9 +42,10 @@ ROWS = [
     ("BM_ScanGridPaper/800", "ScanGrid of an 800-point IBEO-like scan at 0.5 m", None),
     ("BM_TrackerUpdate/200", "tracker update, 200 tracks and 200 measurements, one thread", None),
     ("BM_ClusterReturns/200", "clustering 20 000 returns in 200 clusters, one thread", None),
-    ("BM_TrackerScan/n:200/free_space_check:0/open_ends:0", "a whole scan of tracking: 20 000 returns in 200 objects, one thread", None),
-    ("BM_TrackerScan/n:200/free_space_check:1/open_ends:0", "the same with the free-space check on a 100 m ScanGrid", "BM_TrackerScan/n:200/free_space_check:0/open_ends:0"),
-    ("BM_TrackerScan/n:200/free_space_check:1/open_ends:1", "the same with step open ends too (the default)", "BM_TrackerScan/n:200/free_space_check:1/open_ends:0"),
+    ("BM_TrackerScan/n:200/free_space_check:0/open_ends:0/duplicates:0", "a whole scan of tracking: 20 000 returns in 200 objects, one thread", None),
+    ("BM_TrackerScan/n:200/free_space_check:1/open_ends:0/duplicates:0", "the same with the free-space check on a 100 m ScanGrid", "BM_TrackerScan/n:200/free_space_check:0/open_ends:0/duplicates:0"),
+    ("BM_TrackerScan/n:200/free_space_check:1/open_ends:1/duplicates:0", "the same with step open ends too", "BM_TrackerScan/n:200/free_space_check:1/open_ends:0/duplicates:0"),
+    ("BM_TrackerScan/n:200/free_space_check:1/open_ends:1/duplicates:1", "the same with step duplicates too (the default)", "BM_TrackerScan/n:200/free_space_check:1/open_ends:1/duplicates:0"),
     ("BM_PriorFillWindow/1/0", "the PriorGrid window the fusion samples, coverage test", None),
 ]
 

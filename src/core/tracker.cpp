@@ -591,8 +591,15 @@ void Tracker::dropDuplicates(std::vector<Track>& tracks, double stamp)
     return tracks[a].hits != tracks[b].hits ? tracks[a].hits > tracks[b].hits : tracks[a].id < tracks[b].id;
   });
   std::vector<ObjectBox> boxes;
+  std::vector<double> reach;  // how far from its centre the grown box reaches
   boxes.reserve(moving.size());
-  for (std::size_t j : moving) boxes.push_back(objectBox(tracks[j], params_, measurements_));
+  reach.reserve(moving.size());
+  const double margin = params_.fragment_margin;
+  for (std::size_t j : moving)
+  {
+    boxes.push_back(objectBox(tracks[j], params_, measurements_));
+    reach.push_back(std::hypot(0.5 * boxes.back().length + margin, 0.5 * boxes.back().width + margin));
+  }
   std::vector<char> dropped(tracks.size(), 0);
   for (std::size_t a = 0; a < moving.size(); ++a)
   {
@@ -601,7 +608,9 @@ void Tracker::dropDuplicates(std::vector<Track>& tracks, double stamp)
     for (std::size_t b = a + 1; b < moving.size(); ++b)
     {
       const Track& other = tracks[moving[b]];
-      if (dropped[moving[b]] || !inBox(boxes[a], boxes[b].centre, params_.fragment_margin)) continue;
+      const double dx = boxes[b].centre.x - boxes[a].centre.x, dy = boxes[b].centre.y - boxes[a].centre.y;
+      if (dropped[moving[b]] || dx * dx + dy * dy > reach[a] * reach[a] || !inBox(boxes[a], boxes[b].centre, margin))
+        continue;
       if (keep.velocity().x * other.velocity().x + keep.velocity().y * other.velocity().y <
           kDuplicateMinCosine * keep.speed() * other.speed())
         continue;
