@@ -615,7 +615,7 @@ void Tracker::dropDuplicates(std::vector<Track>& tracks, double stamp)
           kDuplicateMinCosine * keep.speed() * other.speed())
         continue;
       dropped[moving[b]] = 1;
-      keep.fragments.push_back(tracks[moving[b]].measurement);
+      keep.fragments.push_back(other.measurement);
       ++counts_.duplicates;
       ++counts_.tracks_deleted;
     }
