@@ -344,9 +344,19 @@ std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading,
 ObjectBox objectBox(const Track& t, const TrackerParams& p, const std::vector<Measurement>& measurements)
 {
   ObjectBox b = ownBox(t);
-  if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0) || t.measurement < 0 ||
-      t.measurement >= static_cast<int>(measurements.size()))
+  if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0)) return b;
+  if (t.measurement < 0)
+  {
+    if (!t.seen_box.valid) return b;
+    const double heading = std::atan2(t.x(3), t.x(2)), c = std::cos(heading), s = std::sin(heading);
+    b.centre = Point2{ t.x(0) + c * t.seen_box.along - s * t.seen_box.across,
+                       t.x(1) + s * t.seen_box.along + c * t.seen_box.across };
+    b.yaw = heading + t.seen_box.yaw;
+    b.length = t.seen_box.length;
+    b.width = t.seen_box.width;
     return b;
+  }
+  if (t.measurement >= static_cast<int>(measurements.size())) return b;
   const Measurement& m = measurements[t.measurement];
   const std::optional<Measurement> e =
       hiddenLengthBox(m, std::atan2(t.x(3), t.x(2)), p.evidence_hidden_length, p.evidence_end_width);
@@ -779,6 +789,25 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     ++counts_.tracks_created;
   }
   tracks_ = std::move(kept);
+  if (params_.hidden_centre) rememberSeenBoxes();
+}
+
+void Tracker::rememberSeenBoxes()
+{
+  for (Track& t : tracks_)
+  {
+    if (t.measurement < 0) continue;
+    t.seen_box.valid = t.motion == TrackMotion::kMoving && t.speed() > 0.0;
+    if (!t.seen_box.valid) continue;
+    const ObjectBox b = objectBox(t, params_, measurements_);
+    const double heading = std::atan2(t.x(3), t.x(2)), c = std::cos(heading), s = std::sin(heading);
+    const double dx = b.centre.x - t.x(0), dy = b.centre.y - t.x(1);
+    t.seen_box.along = c * dx + s * dy;
+    t.seen_box.across = -s * dx + c * dy;
+    t.seen_box.yaw = std::remainder(b.yaw - heading, 2.0 * M_PI);
+    t.seen_box.length = b.length;
+    t.seen_box.width = b.width;
+  }
 }
 
 }  // namespace core

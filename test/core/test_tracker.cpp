@@ -969,6 +969,49 @@ TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)
   expectOwnBox(no_length, width);
 }
 
+TEST(Tracker, HiddenCentreKeepsTheLastSeenBoxWhileTheTrackCoasts)
+{
+  TrackerParams p;
+  const double len = p.evidence_hidden_length, width = 1.8;
+  for (const bool step : { true, false })
+  {
+    SCOPED_TRACE(step ? "step hidden centre" : "without it");
+    TrackerParams params = p;
+    params.hidden_centre = step;
+    double face = 0.0;
+    Tracker tracker = faceTracker(params, 10.0, 1.0, width, face);
+    ASSERT_EQ(tracker.tracks().size(), 1u);
+    const ObjectBox seen = reportedBox(tracker.tracks()[0], tracker);
+    const Point2 seen_at = tracker.tracks()[0].position(), v = tracker.tracks()[0].velocity();
+    // A scan without its returns (the sparse lidar missed it): the track coasts on its prediction.
+    const std::vector<float> none;
+    tracker.update(0.9, Pose2{ 0.0, 0.0, 0.0 }, ObstaclePoints{ none.data(), 0 });
+    ASSERT_EQ(tracker.tracks().size(), 1u);
+    const Track& t = tracker.tracks()[0];
+    ASSERT_EQ(t.state, TrackState::kCoasting);
+    ASSERT_EQ(t.measurement, -1);
+    ASSERT_EQ(t.motion, TrackMotion::kMoving);
+    EXPECT_NEAR(t.x(0) - seen_at.x, 0.1 * v.x, 1e-9) << "the constant-velocity prediction";
+    const ObjectBox coast = reportedBox(t, tracker);
+    if (step)
+    {
+      // The box the last sighting reported, moved with the track: no jump back to the face.
+      EXPECT_NEAR(seen.centre.x, face + 0.5 * len, 0.2);
+      EXPECT_NEAR(coast.centre.x, seen.centre.x + 0.1 * v.x, 1e-9);
+      EXPECT_NEAR(coast.centre.y, seen.centre.y + 0.1 * v.y, 1e-9);
+      EXPECT_NEAR(coast.yaw, seen.yaw, 1e-9);
+      EXPECT_NEAR(coast.length, len, 1e-9);
+      EXPECT_NEAR(coast.width, seen.width, 1e-9);
+    }
+    else
+    {
+      EXPECT_EQ(coast.centre.x, t.x(0));
+      EXPECT_EQ(coast.centre.y, t.x(1));
+      EXPECT_EQ(coast.length, t.extent_length);
+    }
+  }
+}
+
 TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
 {
   const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };

@@ -130,7 +130,8 @@ struct TrackerParams
   bool evidence_small_box = true;
   /// Step "hidden centre": a moving track seen end-on (as for step hidden length, with evidence_hidden_length > 0)
   /// reports (reportedBox(): the tracks topic, the scoring) the box of step hidden length and its centre, half a
-  /// vehicle's length behind the face seen, instead of the face's.
+  /// vehicle's length behind the face seen, instead of the face's. A scan that misses it (the track coasts) keeps
+  /// that box where its last sighting put it, relative to the track's position and heading (Track::seen_box).
   bool hidden_centre = true;
   /// Step "open ends": which end of a partly seen cluster is the object's end. The box of a cluster shorter than the
   /// track's is anchored on the cluster's end nearest the sensor, but an occluder nearer the sensor can cut exactly
@@ -298,6 +299,16 @@ struct Sighting
   std::vector<Point2> points;
 };
 
+/// The box a moving track reported in its last scan with a measurement (objectBox()), relative to its position and
+/// heading then: a coasting track reports it moved and turned with the track.
+struct SeenBox
+{
+  bool valid = false;
+  double along = 0.0, across = 0.0;  ///< m, the box's centre from the track's position, along and across its heading
+  double yaw = 0.0;                  ///< rad, the box's heading from the track's
+  double length = 0.0, width = 0.0;  ///< m
+};
+
 /// A tracked object. State x = (x, y, vx, vy) in the map frame, covariance P.
 struct Track
 {
@@ -321,6 +332,7 @@ struct Track
   /// Step free-space check: free space showed that it moved (it stays so); its sightings of the last free_space_time.
   bool motion_seen = false;
   std::vector<Sighting> sightings;
+  SeenBox seen_box;  ///< step hidden centre: the box it reported when last seen
 
   Point2 position() const { return Point2{ x(0), x(1) }; }
   Point2 velocity() const { return Point2{ x(2), x(3) }; }
@@ -380,7 +392,9 @@ std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading,
  * @brief The object the track @p t reports, with its last scan's @p measurements: its position with its box
  *        (ownBox()); with step hidden centre (TrackerParams::hidden_centre and evidence_hidden_length > 0), a moving
  *        track seen end-on in its last measurement reports the box of step hidden length along its heading, its
- *        position moved by as much as that box's centre lies from the point the track follows (referencePoint()).
+ *        position moved by as much as that box's centre lies from the point the track follows (referencePoint());
+ *        a moving track without a measurement in the last scan (coasting) reports Track::seen_box, moved and turned
+ *        with its position and heading.
  */
 ObjectBox objectBox(const Track& t, const TrackerParams& params, const std::vector<Measurement>& measurements);
 
@@ -429,6 +443,8 @@ private:
   /// Step duplicates: deletes from @p tracks the duplicates of moving tracks seen at @p stamp; their clusters become
   /// the kept tracks' fragments.
   void dropDuplicates(std::vector<Track>& tracks, double stamp);
+  /// Step hidden centre: each moving track seen this scan remembers the box it reports (Track::seen_box).
+  void rememberSeenBoxes();
 
   TrackerParams params_;
   std::vector<Track> tracks_;
