@@ -10,6 +10,7 @@ import time
 import warnings
 
 import optuna
+import yaml
 from optuna.trial import TrialState
 
 from . import drives as drv
@@ -314,6 +315,37 @@ def best_trial(study):
     if not complete:
         raise TuneError(f"study '{study.study_name}' has no complete trial to report")
     return max(complete, key=lambda t: t.value)
+
+
+PROFILE_HEADER_END = "every other key as in config/"
+
+
+def refresh_profile(setup, log=print):
+    """Re-renders the learned profile at --profile-out over --config: its learned values (the search space's keys,
+    read from its own files) substituted into the current configuration, its header kept. A profile written before
+    config/ gained or changed keys is then again every key of config/ but the learned ones."""
+    d = os.path.abspath(setup.args.profile_out)
+    try:
+        learned = sp.base_values(d)
+        with open(os.path.join(d, "fusion.yaml")) as f:
+            lines = f.readlines()
+    except (OSError, yaml.YAMLError) as e:
+        raise TuneError(f"profile {d}: {e}")
+    end = next((i for i, ln in enumerate(lines) if not ln.startswith("#") or PROFILE_HEADER_END in ln), None)
+    if end is None or PROFILE_HEADER_END not in lines[end]:
+        raise TuneError(f"profile {d}: fusion.yaml does not start with the header learning/tune --report writes")
+    header = "".join(lines[:end + 1])
+    values = {}
+    for p in setup.params:
+        if p.name not in learned.get(p.file, {}):
+            raise TuneError(f"profile {d}: {p.file} has no {p.name}")
+        values.setdefault(p.file, {})[p.name] = learned[p.file][p.name]
+    sp.write_config_dir(d, values, setup.config, header)
+    error = sp.check_config_dir(setup.evaluate, d)
+    if error:
+        raise TuneError(f"profile {d}: {error}")
+    log(f"refreshed {d}/ over {setup.config}: {len(setup.params)} learned values kept")
+    return 0
 
 
 def report(setup, log=print):

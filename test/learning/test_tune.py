@@ -171,3 +171,43 @@ def test_bad_search_space_is_a_one_line_error_naming_the_parameter(tmp_path, too
     sp.write_text(text)
     line = one_line_error(run_tune(["--drives", ds, "--space", str(sp), "--work", str(tmp_path / "w")]))
     assert named in line, line
+
+
+def test_refresh_profile_renders_the_learned_values_over_the_current_configuration(tmp_path, tools):
+    """A profile written before config/ gained a key (the tracker's) or changed one (the ScanGrid's size) becomes every
+    key of config/ again, with its learned values, its header and the IBEO sensor's lines kept."""
+    import shutil
+    prof = tmp_path / "learned"
+    shutil.copytree(os.path.join(ROOT, "config", "learned"), prof)
+    learned_before = space.base_values(str(prof))
+    fusion_text = (prof / "fusion.yaml").read_text()
+    header = "".join(fusion_text.splitlines(keepends=True)[:2])
+    # Age it: drop a key config/ has, change one no study learns.
+    (prof / "fusion.yaml").write_text("".join(ln for ln in fusion_text.splitlines(keepends=True)
+                                              if not ln.startswith("tracker_gate:")))
+    scan = (prof / "scan_grid.yaml").read_text()
+    (prof / "scan_grid.yaml").write_text(scan.replace("\ngrid_size_x:", "\ngrid_size_x: 77.0 #", 1))
+    r = run_tune(["--refresh-profile", "--profile-out", str(prof)])
+    assert r.returncode == 0, r.stdout + r.stderr
+    config = space.base_values(os.path.join(ROOT, "config"))
+    after = space.base_values(str(prof))
+    learned_keys = {(p.file, p.name) for p in space.load_space(os.path.join(ROOT, "learning", "search_space.yaml"))}
+    for file, values in config.items():
+        assert set(after[file]) == set(values), file
+        for key, value in values.items():
+            expected = learned_before[file][key] if (file, key) in learned_keys else value
+            assert after[file][key] == pytest.approx(expected, abs=1e-6) if isinstance(value, float) \
+                else after[file][key] == expected, (file, key)
+    assert (prof / "fusion.yaml").read_text().startswith(header)
+    ibeo = yaml.safe_load((prof / "ibeo" / "scan_grid.yaml").read_text())
+    assert ibeo["ground_model"] == "flat" and ibeo["relative_height_limit"] == 0.0  # the sensor's lines kept
+    assert ibeo["mu_free"] == pytest.approx(learned_before["scan_grid.yaml"]["mu_free"], abs=1e-6)
+    assert space.check_config_dir(tools["evaluate"], str(prof)) is None
+
+
+def test_refresh_profile_without_a_learned_header_is_a_one_line_error(tmp_path):
+    import shutil
+    prof = tmp_path / "learned"
+    shutil.copytree(os.path.join(ROOT, "config", "learned"), prof)
+    (prof / "fusion.yaml").write_text((prof / "fusion.yaml").read_text().split("\n", 2)[2])
+    assert "does not start with the header" in one_line_error(run_tune(["--refresh-profile", "--profile-out", str(prof)]))

@@ -247,11 +247,26 @@ TEST(Profiles, LearnedProfileIsCompleteValidAndKeepsTheIbeoSensorLines)
   const core::ScanGridParams ibeo = loadFile<core::ScanGridParams>(dir + "ibeo/scan_grid.yaml");
   EXPECT_NO_THROW(scan.validate());
   EXPECT_NO_THROW(ibeo.validate());
-  const auto a = valuesOf(ibeo), b = valuesOf(scan);
-  std::set<std::string> differ;
-  for (const auto& kv : a)
-    if (b.at(kv.first) != kv.second) differ.insert(kv.first);
-  EXPECT_EQ(differ, (std::set<std::string>{ "azimuth_resolution_deg", "ground_model", "relative_height_limit" }));
+  // Where config/ibeo/ differs from config/ (the sensor's lines), and nowhere else.
+  auto differing = [](const core::ScanGridParams& x, const core::ScanGridParams& y) {
+    const auto a = valuesOf(x), b = valuesOf(y);
+    std::set<std::string> out;
+    for (const auto& kv : a)
+      if (b.at(kv.first) != kv.second) out.insert(kv.first);
+    return out;
+  };
+  const std::string config = std::string(MAF_PACKAGE_DIR) + "/config/";
+  const std::set<std::string> sensor = differing(loadFile<core::ScanGridParams>(config + "ibeo/scan_grid.yaml"),
+                                                 loadFile<core::ScanGridParams>(config + "scan_grid.yaml"));
+  EXPECT_TRUE(sensor.count("ground_model") && sensor.count("azimuth_resolution_deg"));
+  EXPECT_EQ(differing(ibeo, scan), sensor);
+  // Every key of config/ (`learning/tune --refresh-profile` re-renders a profile when config/ gains keys).
+  for (const char* f : { "fusion.yaml", "scan_grid.yaml", "prior_grid.yaml", "ibeo/scan_grid.yaml" })
+  {
+    const YAML::Node base = YAML::LoadFile(config + f), learned = YAML::LoadFile(dir + f);
+    for (const auto& kv : base)
+      EXPECT_TRUE(learned[kv.first.as<std::string>()].IsDefined()) << f << ": " << kv.first.as<std::string>();
+  }
   map_io::PriorGridParams prior;
   map_io::forEachPriorGridParam(prior, map_io::yamlReader(YAML::LoadFile(dir + "prior_grid.yaml")));
   EXPECT_NO_THROW(prior.beta.validate());
