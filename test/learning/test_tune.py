@@ -1,6 +1,7 @@
 """learning/tune on two short drives with file storage: a 6-trial study that resumes, trials that crash or time out
 recorded as failed, interrupted trials, the report, and the one-line errors of bad input."""
 import os
+import shutil
 import socket
 import stat
 import subprocess
@@ -176,7 +177,6 @@ def test_bad_search_space_is_a_one_line_error_naming_the_parameter(tmp_path, too
 def test_refresh_profile_renders_the_learned_values_over_the_current_configuration(tmp_path, tools):
     """A profile written before config/ gained a key (the tracker's) or changed one (the ScanGrid's size) becomes every
     key of config/ again, with its learned values, its header and the IBEO sensor's lines kept."""
-    import shutil
     prof = tmp_path / "learned"
     shutil.copytree(os.path.join(ROOT, "config", "learned"), prof)
     learned_before = space.base_values(str(prof))
@@ -196,8 +196,9 @@ def test_refresh_profile_renders_the_learned_values_over_the_current_configurati
         assert set(after[file]) == set(values), file
         for key, value in values.items():
             expected = learned_before[file][key] if (file, key) in learned_keys else value
-            assert after[file][key] == pytest.approx(expected, abs=1e-6) if isinstance(value, float) \
-                else after[file][key] == expected, (file, key)
+            if isinstance(value, float):
+                expected = pytest.approx(expected, abs=1e-6)
+            assert after[file][key] == expected, (file, key)
     assert (prof / "fusion.yaml").read_text().startswith(header)
     ibeo = yaml.safe_load((prof / "ibeo" / "scan_grid.yaml").read_text())
     assert ibeo["ground_model"] == "flat" and ibeo["relative_height_limit"] == 0.0  # the sensor's lines kept
@@ -206,7 +207,6 @@ def test_refresh_profile_renders_the_learned_values_over_the_current_configurati
 
 
 def test_refresh_profile_without_a_learned_header_is_a_one_line_error(tmp_path):
-    import shutil
     prof = tmp_path / "learned"
     shutil.copytree(os.path.join(ROOT, "config", "learned"), prof)
     (prof / "fusion.yaml").write_text((prof / "fusion.yaml").read_text().split("\n", 2)[2])
