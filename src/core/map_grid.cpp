@@ -920,8 +920,9 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
     const unsigned target = c.motion == CellClass::kMoving ? FrameMG::kV : FrameMG::kS;
     const unsigned other = c.motion == CellClass::kMoving ? FrameMG::kS : FrameMG::kV;
     // Only sets within {F, S, V}: the static classes stay the prior's and the counter's (a false moving track on a
-    // pole must not take its N); a small mover's (take_n) also within {F, N, S, V}.
-    const unsigned dynamic = FrameMG::kF | FrameMG::kS | FrameMG::kV | (c.take_n ? FrameMG::kN : 0u);
+    // pole must not take its N); a small mover's (take_n) also within {F, N, S, V}, and without a map (take_c) any.
+    const unsigned dynamic =
+        FrameMG::kF | FrameMG::kS | FrameMG::kV | (c.take_n ? FrameMG::kN : 0u) | (c.take_c ? FrameMG::kC : 0u);
     // Sets within {F, other} go to the target, except in a box cell the scan saw free.
     const unsigned agreeing = c.interior && !c.hidden ? 0u : FrameMG::kF | other;
     float mass[kernels::kSubsets];

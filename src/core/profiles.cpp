@@ -77,12 +77,18 @@ const std::vector<AddedStep>& addedSteps()
     { "small_box", "a pedestrian-sized moving track's box grows to a pedestrian's size behind its returns and across",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_small_box; },
       [](Profile& p) { p.tracker.evidence_small_box = false; } },
+    { "small_movers_without_map", "without a prior, a pedestrian-sized moving track also moves to V the sets holding C",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.evidence_small_size > 0.0 && p.tracker.evidence_small_without_map; },
+      [](Profile& p) { p.tracker.evidence_small_without_map = false; } },
     { "open_ends", "a partly seen cluster whose end nearest the sensor is occluded, and the other open, is anchored on the other",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.open_ends; },
       [](Profile& p) { p.tracker.open_ends = false; } },
     { "hidden_centre", "a moving vehicle seen end-on is reported at the centre of the box of step hidden_length, not of its face",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.hidden_centre && p.tracker.evidence_hidden_length > 0.0; },
       [](Profile& p) { p.tracker.hidden_centre = false; } },
+    { "common_motion", "when many confirmed tracks agree on one slow velocity (a drifting pose), motion is decided relative to it",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.common_motion; },
+      [](Profile& p) { p.tracker.common_motion = false; } },
   };
   return steps;
 }

@@ -87,13 +87,13 @@ std::vector<ObjectBox> reportedBoxes(const Tracker& tracker)
   return out;
 }
 
-double motionProbability(const Track& t, const TrackerParams& p)
+double motionProbability(const Track& t, const TrackerParams& p, Point2 common_motion)
 {
-  const double sigma = std::max(t.speedSigma(), kMinSigma);
+  const double sigma = std::max(t.speedSigma(), kMinSigma), speed = t.speedRelativeTo(common_motion);
   switch (t.motion)
   {
-    case TrackMotion::kMoving: return normalCdf((t.speed() - p.moving_speed) / sigma);
-    case TrackMotion::kStopped: return normalCdf((p.stopped_speed - t.speed()) / sigma);
+    case TrackMotion::kMoving: return normalCdf((speed - p.moving_speed) / sigma);
+    case TrackMotion::kStopped: return normalCdf((p.stopped_speed - speed) / sigma);
     case TrackMotion::kUnknown: break;
   }
   return 0.0;
@@ -128,7 +128,7 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     c.motion = t.motion == TrackMotion::kMoving    ? CellClass::kMoving
                : t.motion == TrackMotion::kStopped ? CellClass::kStopped
                                                    : CellClass::kOccupied;
-    c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p));
+    c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p, tracker.commonMotion()));
     c.take_n = c.motion == CellClass::kMoving && p.evidence_small_size > 0.0 &&
                t.extent_length <= p.evidence_small_size && t.extent_width <= p.evidence_small_size;
     const std::size_t first = out.size();
@@ -198,6 +198,8 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
                   background);
   tracker.update(stamp, pose, returns, &background, scan);
   std::vector<CellMotion> cells = trackEvidence(tracker, g);
+  if (!prior && p.evidence_small_without_map)
+    for (CellMotion& c : cells) c.take_c = c.take_n;
   if (scan && tracker.params().evidence_box_hidden) markHidden(cells, g, *scan, pose);
   grid.applyTrackedMotion(cells);
 }

@@ -85,6 +85,10 @@ void TrackerParams::validate() const
   requireInRange("tracker_evidence_small_size", evidence_small_size, 0.0, max_object_width);
   requireInRange("tracker_heading_box_angle", heading_box_angle, 0.0, kMaxHeadingBoxAngle);
   requireInRange("tracker_heading_box_max_length", heading_box_max_length, 0.0, max_object_length);
+  requireInRange("tracker_common_motion_min_tracks", common_motion_min_tracks, 1, 100000);
+  requireInRange("tracker_common_motion_share", common_motion_share, kMinShare, 1.0);
+  requireInRange("tracker_common_motion_sigmas", common_motion_sigmas, 0.0, 10.0);
+  requireInRange("tracker_common_motion_max_speed", common_motion_max_speed, 0.0, max_speed);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -388,6 +392,8 @@ void Tracker::reset()
 {
   counts_.tracks_deleted += tracks_.size();
   tracks_.clear();
+  common_motion_ = Point2{ 0.0, 0.0 };
+  has_common_motion_ = false;
 }
 
 void Tracker::predict(Track& t, double dt) const
@@ -463,7 +469,38 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
 
 bool Tracker::fastEnough(const Track& t, double sigmas) const
 {
-  return t.speed() - sigmas * t.speedSigma() > params_.moving_speed;
+  return decisionSpeed(t) - sigmas * t.speedSigma() > params_.moving_speed;
+}
+
+void Tracker::findCommonMotion(double stamp)
+{
+  common_motion_ = Point2{ 0.0, 0.0 };
+  has_common_motion_ = false;
+  if (!params_.common_motion) return;
+  common_vx_.clear();
+  common_vy_.clear();
+  auto seen = [&](const Track& t) { return t.reported() && t.last_hit >= stamp && finite(t.x, t.P); };
+  for (const Track& t : tracks_)
+    if (seen(t))
+    {
+      common_vx_.push_back(t.x(2));
+      common_vy_.push_back(t.x(3));
+    }
+  const std::size_t n = common_vx_.size();
+  if (n < static_cast<std::size_t>(params_.common_motion_min_tracks)) return;
+  auto median = [n](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n / 2), v.end());
+    return v[n / 2];
+  };
+  const Point2 m{ median(common_vx_), median(common_vy_) };
+  if (!(std::hypot(m.x, m.y) <= params_.common_motion_max_speed)) return;
+  const auto agree = std::count_if(tracks_.begin(), tracks_.end(), [&](const Track& t) {
+    return seen(t) && t.speedRelativeTo(m) <= params_.common_motion_sigmas * t.speedSigma();
+  });
+  if (!(static_cast<double>(agree) > params_.common_motion_share * static_cast<double>(n))) return;
+  common_motion_ = m;
+  has_common_motion_ = true;
+  ++counts_.common_motion_scans;
 }
 
 void Tracker::decideMotion(Track& t, double stamp) const
@@ -473,7 +510,7 @@ void Tracker::decideMotion(Track& t, double stamp) const
     t.motion = TrackMotion::kUnknown;
     return;
   }
-  const double s = t.speed(), sigma = t.speedSigma();
+  const double s = decisionSpeed(t), sigma = t.speedSigma();
   if (s + params_.motion_sigmas * sigma < params_.stopped_speed)
   {
     if (t.still_since < 0.0) t.still_since = stamp;
@@ -722,6 +759,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       if (t.state == TrackState::kConfirmed) t.state = TrackState::kCoasting;
     }
   }
+  findCommonMotion(stamp);
   // Lifecycle: a tentative track missed once, a coasting track too long unseen, a broken state.
   std::vector<Track> kept;
   kept.reserve(tracks_.size() + measurements_.size());

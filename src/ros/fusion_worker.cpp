@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -732,6 +733,15 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("tracks deleted (non-finite or too fast)", c.rejected_tracks);
     status.add("clusters not tracked (fragments of a moving track)", c.fragments);
     status.add("tracks deleted (duplicates of a moving track)", c.duplicates);
+    if (tracker_->hasCommonMotion())
+    {
+      std::ostringstream v;
+      v << std::fixed << std::setprecision(2) << tracker_->commonMotion().x << ", " << tracker_->commonMotion().y;
+      status.add("common motion (last scan) [m/s]", v.str());
+    }
+    else
+      status.add("common motion (last scan) [m/s]", "none");
+    status.add("scans with a common motion", c.common_motion_scans);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }
 }

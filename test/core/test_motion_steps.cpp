@@ -559,6 +559,100 @@ TEST(MotionSteps, SmallMoverCellsAlsoGiveTheirSetsHoldingN)
   EXPECT_EQ(with.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
 }
 
+// Step "small movers without a map": without a prior an occupied cell holds the scan's O = {C, N, S, V}; the cells of
+// a small moving track with CellMotion::take_c also give the sets holding C (here Ω and {C, N, S, V}) to V, half of
+// each at β = 0.5; with take_n alone those keep their mass.
+TEST(MotionSteps, SmallMoverCellsWithoutAMapAlsoGiveTheirSetsHoldingC)
+{
+  World world;
+  world.boxes.push_back({ 10.0, -0.3, 10.6, 0.3, 1.7 });
+  core::Run with(defaultProfile()), without(defaultProfile());
+  for (int k = 0; k < 4; ++k)
+  {
+    with.step(world, Pose2{ 0.0, 0.0, 0.0 });
+    without.step(world, Pose2{ 0.0, 0.0, 0.0 });
+  }
+  const GridGeometry& g = with.grid.geometry();
+  CellIndex ci;
+  ASSERT_TRUE(g.worldToCell(Point2{ 10.1, 0.1 }, ci));
+  const std::size_t i = g.index(ci);
+  const std::vector<float> before = massesOf(with.grid, i);
+  ASSERT_EQ(massesOf(without.grid, i), before);
+  const Subset cnsv = FrameMG::kC | FrameMG::kN | FrameMG::kS | FrameMG::kV;
+  ASSERT_GT(before[cnsv], 0.1f) << "the scan's occupied evidence, no prior to tell C";
+  CellMotion small{ i, CellClass::kMoving, 0.5f };
+  small.take_n = small.take_c = true;
+  CellMotion n_only = small;
+  n_only.take_c = false;
+  with.grid.applyTrackedMotion({ small });
+  without.grid.applyTrackedMotion({ n_only });
+  expectHalfMovedToV(before, massesOf(with.grid, i), [](Subset a) {
+    return a != FrameMG::kV && ((a & FrameMG::kV) || (a & ~(FrameMG::kF | FrameMG::kS)) == 0);
+  });
+  const std::vector<float> kept = massesOf(without.grid, i);
+  EXPECT_EQ(kept[cnsv], before[cnsv]) << "take_n alone leaves {C, N, S, V}";
+  EXPECT_EQ(kept[FrameMG::kOmega], before[FrameMG::kOmega]) << "and Ω";
+  EXPECT_EQ(with.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
+  EXPECT_NE(without.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
+}
+
+// The same step through trackScan(): a pedestrian walking at 1.5 m/s across open ground, tracked scan by scan. On the
+// last scan, in every cell of its track evidence (a small mover's), the sets holding C keep 1 − β of their mass
+// without a prior, and all of it with the step off or with a prior (a pavement: trackScan() sets no take_c).
+TEST(MotionSteps, TrackScanLetsASmallMoverTakeCOnlyWithoutAPrior)
+{
+  constexpr int kScans = 20;
+  constexpr double kSpeed = 1.5;
+  struct Case
+  {
+    bool step, with_prior;
+  };
+  for (const Case c : { Case{ true, false }, Case{ false, false }, Case{ true, true } })
+  {
+    Profile profile = defaultProfile();
+    profile.tracker.evidence_small_without_map = c.step;
+    core::Run run(profile);
+    const GridGeometry& g = run.grid.geometry();
+    PriorWindow pavement;
+    pavement.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
+    std::fill(pavement.other.begin(), pavement.other.end(), 0.85f);
+    const PriorWindow* prior = c.with_prior ? &pavement : nullptr;
+    Tracker tracker(profile.tracker);
+    std::vector<std::uint8_t> background;
+    MapGrid before(profile.map_grid);
+    for (int k = 0; k < kScans; ++k)
+    {
+      const double x = 8.0 + kSpeed * kScanPeriod * k;
+      World world;
+      world.boxes.push_back({ x, 3.0, x + 0.5, 3.5, 1.7 });
+      run.step(world, Pose2{ 0.0, 0.0, 0.0 }, prior);
+      if (k + 1 == kScans) before = run.grid;
+      trackScan(tracker, run.grid, kScanPeriod * run.scans, Pose2{ 0.0, 0.0, 0.0 }, run.builder.obstaclePoints(),
+                background, &run.scan, prior);
+    }
+    ASSERT_EQ(tracker.tracks().size(), 1u);
+    ASSERT_EQ(tracker.tracks()[0].motion, TrackMotion::kMoving);
+    const std::vector<CellMotion> cells = trackEvidence(tracker, g);
+    ASSERT_FALSE(cells.empty());
+    const bool takes_c = c.step && !c.with_prior;
+    double holding_c = 0.0;
+    for (const CellMotion& m : cells)
+    {
+      ASSERT_TRUE(m.take_n);
+      ASSERT_GT(m.weight, 0.5f);
+      const std::vector<float> was = massesOf(before, m.cell), is = massesOf(run.grid, m.cell);
+      for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+        if ((a & FrameMG::kC) && (a & FrameMG::kV))
+        {
+          holding_c += was[a];
+          EXPECT_NEAR(is[a], takes_c ? (1.0f - m.weight) * was[a] : was[a], 1e-6)
+              << subsetName<FrameMG>(a) << ", step " << c.step << ", prior " << c.with_prior;
+        }
+    }
+    EXPECT_GT(holding_c, 0.1) << "the cells held mass on sets holding C";
+  }
+}
+
 // priorBetPBuilding() is BetP(C) of the prior's mass function (pignistic() of PriorWindow::cell()), on cells of every
 // kind: building, road, other, a wall outline, a softened edge and Ω.
 TEST(MotionSteps, PriorBetPBuildingIsThePignisticOfThePriorCell)

@@ -1232,3 +1232,117 @@ TEST(Tracker, OpenEndDistanceIsValidatedByName)
                         { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = 11.0; } },
                         { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = std::nan(""); } } });
 }
+
+namespace {
+
+constexpr int kStaticObjects = 24;  // above tracker_common_motion_min_tracks (20)
+constexpr int kDriftScans = 30;
+
+/// Scan @p k (0.1 s apart) of kStaticObjects static objects 4 m apart and one walker at @p walker_speed along −y, all
+/// seen through a pose that drifts at @p drift m/s along x (the map frame moves them all by as much).
+std::vector<Measurement> driftScan(int k, double drift, double walker_speed)
+{
+  const double t = 0.1 * k;
+  std::vector<Measurement> out;
+  for (int j = 0; j < kStaticObjects; ++j) out.push_back(at(drift * t + 4.0 * j, 10.0 + (j % 3)));
+  out.push_back(at(drift * t + 40.0, -20.0 - walker_speed * t));
+  return out;
+}
+
+}  // namespace
+
+// Step common motion: a pose drifting at 1.2 m/s makes every static object's track move at 1.2 m/s. With the step,
+// their median is the scan's common motion and, relative to it, none is moving (they end stopped), while a walker at
+// 1.5 m/s relative to them is; without it every static track is moving. The step changes no track's state.
+TEST(Tracker, CommonMotionOfADriftingPoseIsNoMotion)
+{
+  TrackerParams on;
+  ASSERT_TRUE(on.common_motion);
+  ASSERT_LT(on.common_motion_min_tracks, kStaticObjects + 1);
+  TrackerParams off = on;
+  off.common_motion = false;
+  Tracker with(on), without(off);
+  constexpr double kDrift = 1.2, kWalker = 1.5;
+  for (int k = 0; k < kDriftScans; ++k)
+  {
+    with.update(0.1 * k, driftScan(k, kDrift, kWalker));
+    without.update(0.1 * k, driftScan(k, kDrift, kWalker));
+  }
+  ASSERT_EQ(with.tracks().size(), static_cast<std::size_t>(kStaticObjects + 1));
+  ASSERT_EQ(without.tracks().size(), with.tracks().size());
+  ASSERT_TRUE(with.hasCommonMotion());
+  EXPECT_FALSE(without.hasCommonMotion());
+  EXPECT_EQ(without.counts().common_motion_scans, 0u);
+  // Confirmed from the third scan: a common motion on every scan from there.
+  EXPECT_EQ(with.counts().common_motion_scans, static_cast<std::uint64_t>(kDriftScans - on.confirm_hits + 1));
+  const Track& first = with.tracks()[0];
+  EXPECT_EQ(with.commonMotion().x, first.x(2)) << "the static tracks share one velocity: the median is it";
+  EXPECT_EQ(with.commonMotion().y, first.x(3));
+  EXPECT_NEAR(with.commonMotion().x, kDrift, 0.05);
+  for (std::size_t i = 0; i < with.tracks().size(); ++i)
+  {
+    const Track& a = with.tracks()[i];
+    const Track& b = without.tracks()[i];
+    ASSERT_EQ(a.id, b.id);
+    EXPECT_EQ(a.x, b.x) << "the filter is the same";
+    const bool walker = i + 1 == with.tracks().size();
+    EXPECT_EQ(a.motion, walker ? TrackMotion::kMoving : TrackMotion::kStopped) << "track " << a.id;
+    EXPECT_EQ(b.motion, TrackMotion::kMoving) << "track " << b.id << " without the step";
+    EXPECT_NEAR(with.decisionSpeed(a), walker ? std::hypot(0.0, kWalker) : 0.0, 0.05);
+    EXPECT_EQ(without.decisionSpeed(b), b.speed());
+  }
+}
+
+// A common motion must be slow, shared by most tracks, and seen on enough of them: traffic at 8 m/s and a drift seen
+// on too few tracks never have one, a scene whose tracks split evenly between two motions has none once their
+// velocities are known, and every decision stays the one without the step.
+TEST(Tracker, TrafficFewTracksAndSplitMotionsAreNoCommonMotion)
+{
+  TrackerParams on, off;
+  off.common_motion = false;
+  auto run = [](const TrackerParams& p, int objects, double v_first, double v_rest, int first_count) {
+    Tracker tracker(p);
+    for (int k = 0; k < kDriftScans; ++k)
+    {
+      std::vector<Measurement> scan;
+      for (int j = 0; j < objects; ++j)
+        scan.push_back(at((j < first_count ? v_first : v_rest) * 0.1 * k + 5.0 * j, 3.0 * (j % 4)));
+      tracker.update(0.1 * k, scan);
+    }
+    return tracker;
+  };
+  struct Case
+  {
+    const char* what;
+    int objects;
+    double v_first, v_rest;
+    int first_count;
+  };
+  for (const Case& c : { Case{ "traffic at 8 m/s", 24, 8.0, 8.0, 24 }, Case{ "a drift on 19 tracks", 19, 1.2, 1.2, 19 },
+                         Case{ "12 at rest, 12 at 1.5 m/s", 24, 0.0, 1.5, 12 } })
+  {
+    const Tracker with = run(on, c.objects, c.v_first, c.v_rest, c.first_count);
+    const Tracker without = run(off, c.objects, c.v_first, c.v_rest, c.first_count);
+    EXPECT_FALSE(with.hasCommonMotion()) << c.what;
+    // The split scene's first confirmed scans have one: every velocity is still uncertain enough to agree with it.
+    if (c.v_first == c.v_rest)
+    {
+      EXPECT_EQ(with.counts().common_motion_scans, 0u) << c.what;
+    }
+    ASSERT_EQ(with.tracks().size(), without.tracks().size()) << c.what;
+    for (std::size_t i = 0; i < with.tracks().size(); ++i)
+      EXPECT_EQ(with.tracks()[i].motion, without.tracks()[i].motion) << c.what << ", track " << i;
+  }
+}
+
+TEST(Tracker, CommonMotionParametersAreValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_common_motion_min_tracks", [](TrackerParams& p) { p.common_motion_min_tracks = 0; } },
+      { "tracker_common_motion_share", [](TrackerParams& p) { p.common_motion_share = 0.0; } },
+      { "tracker_common_motion_share", [](TrackerParams& p) { p.common_motion_share = 1.5; } },
+      { "tracker_common_motion_sigmas", [](TrackerParams& p) { p.common_motion_sigmas = -1.0; } },
+      { "tracker_common_motion_sigmas", [](TrackerParams& p) { p.common_motion_sigmas = std::nan(""); } },
+      { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = -0.1; } },
+      { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = 1e3; } } });
+}

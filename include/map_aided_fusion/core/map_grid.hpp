@@ -189,6 +189,8 @@ struct CellMotion
   bool hidden = false;
   /// Sets holding N move too (step "small movers"): a pedestrian on a pavement whose prior is {N, S, V}.
   bool take_n = false;
+  /// Sets holding C move too (step small movers without a map: without a prior, C is not told from N, S and V).
+  bool take_c = false;
 };
 
 /// An object made of a connected region of moving or stopped cells.
@@ -346,7 +348,8 @@ public:
    * A ⊆ {F, S} (a mover where space was free or an object stopped, as the paper's ⊛ sends the free-to-occupied
    * conflict to V); kStopped likewise to {S} (S ∈ A or A ⊆ {F, V}). Sets holding C or N are left alone: the static
    * classes stay the prior's and the counter's (measured: moving evidence on them lets false moving tracks on poles
-   * and trees take N). Each transfer keeps the total: the result is a mass function. BetP and decisions of the listed cells are computed again; a kOccupied cell decided S or V is
+   * and trees take N), except those holding N for CellMotion::take_n and C for CellMotion::take_c. Each transfer keeps
+   * the total: the result is a mass function. BetP and decisions of the listed cells are computed again; a kOccupied cell decided S or V is
    * then decided CellClass::kOccupied (an object whose motion is not yet known is neither).
    */
   void applyTrackedMotion(const std::vector<CellMotion>& cells);

@@ -6,7 +6,8 @@
  *        makes its cells neither S nor V (MapGrid::applyTrackedMotion()).
  *
  * P(moving) = Φ((speed − tracker_moving_speed) / σ(speed)), P(stopped) = Φ((tracker_stopped_speed − speed) /
- * σ(speed)), Φ the standard normal distribution function: how sure the track's velocity makes the motion.
+ * σ(speed)), Φ the standard normal distribution function: how sure the track's velocity makes the motion (the speed
+ * relative to the scan's common motion, step common motion).
  */
 #pragma once
 
@@ -18,9 +19,10 @@
 namespace map_aided_fusion {
 namespace core {
 
-/// The probability, from the track's speed and its σ, that it moves faster than moving_speed (moving) or slower
-/// than stopped_speed (stopped); 0 for a track whose motion is not decided.
-double motionProbability(const Track& track, const TrackerParams& params);
+/// The probability, from the track's speed relative to @p common_motion (step common motion, Tracker::commonMotion())
+/// and its σ, that it moves faster than moving_speed (moving) or slower than stopped_speed (stopped); 0 for a track
+/// whose motion is not decided.
+double motionProbability(const Track& track, const TrackerParams& params, Point2 common_motion = Point2{ 0.0, 0.0 });
 
 /// objectBox() of the track @p t of @p tracker, with its last scan's measurements.
 ObjectBox reportedBox(const Track& t, const Tracker& tracker);
@@ -54,7 +56,8 @@ float priorBetPBuilding(const PriorWindow& prior, std::size_t i);
  *        priorBetPBuilding(), when given), updates @p tracker with the scan's ScanGrid @p scan (vehicle frame; the
  *        free space of step free-space check, nullptr: none), and applies its evidence to @p grid
  *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan; @p prior is
- *        the prior the grid's update() fused (nullptr: none).
+ *        the prior the grid's update() fused (nullptr: none). Without a prior, with step small movers without a map,
+ *        a small mover's cells (CellMotion::take_n) also take C (CellMotion::take_c).
  */
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
                std::vector<std::uint8_t>& background, const ScanMassGrid* scan = nullptr,

@@ -142,6 +142,22 @@ struct TrackerParams
   /// Needs a ScanGrid.
   bool open_ends = true;
   double open_end_distance = 1.0;  ///< m in [0, 10]: how far beyond a cluster's end both tests look
+  /// Step "common motion": a pose that drifts (a localisation's slow error) moves the whole static world in the map
+  /// frame, and the track of every static object takes that drift as its velocity (KITTI 00's first sweeps: 1.0 to
+  /// 1.6 m/s, all one way). The scan's common motion (Tracker::commonMotion()) is the median velocity, per axis, of
+  /// the confirmed tracks seen in the scan when there are at least common_motion_min_tracks of them, that median is
+  /// no faster than common_motion_max_speed (a drift, not traffic) and more than common_motion_share of them lie
+  /// within common_motion_sigmas σ(speed) of it (one motion, not a mix). The motion decision (moving, stopped, the
+  /// free-space check's speed test) and P(motion) of track evidence then take each track's speed relative to it;
+  /// the velocities reported stay the tracks'.
+  bool common_motion = true;
+  int common_motion_min_tracks = 20;
+  double common_motion_share = 0.5;      ///< in (0, 1]
+  double common_motion_sigmas = 2.0;     ///< σ(speed) of a track from the median that still agrees with it
+  double common_motion_max_speed = 2.0;  ///< m/s
+  /// Step "small movers without a map": without a prior the grid never tells C from the other occupied classes (the
+  /// scan's O is {C, N, S, V}), so a small mover's cells (step small movers) also move to V the sets holding C.
+  bool evidence_small_without_map = true;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -199,6 +215,12 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_evidence_small_box", p.evidence_small_box, { "", "step small box: a small mover's track box is grown to tracker_evidence_small_size along and across the line of sight" });
   get("tracker_open_ends", p.open_ends, { "", "step open ends: a partly seen cluster whose end nearest the sensor is occluded, and the other open, is anchored on the other" });
   get("tracker_open_end_distance", p.open_end_distance, { "m", "how far beyond a cluster's end step open ends looks for free space and for an occluder's shadow" });
+  get("tracker_common_motion", p.common_motion, { "", "step common motion: the motion decision takes speeds relative to the median velocity of many tracks that agree with it (a drifting pose)" });
+  get("tracker_common_motion_min_tracks", p.common_motion_min_tracks, { "tracks", "confirmed tracks seen in the scan below which there is no common motion" });
+  get("tracker_common_motion_share", p.common_motion_share, { "", "share of those tracks that must agree with the median velocity" });
+  get("tracker_common_motion_sigmas", p.common_motion_sigmas, { "", "a track agrees with the median when within this many σ(speed) of it" });
+  get("tracker_common_motion_max_speed", p.common_motion_max_speed, { "m/s", "a faster median is traffic, not a drift: no common motion" });
+  get("tracker_evidence_small_without_map", p.evidence_small_without_map, { "", "step small movers without a map: without a prior a small mover's cells also move the sets holding C to V" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -337,6 +359,8 @@ struct Track
   Point2 position() const { return Point2{ x(0), x(1) }; }
   Point2 velocity() const { return Point2{ x(2), x(3) }; }
   double speed() const { return x.tail<2>().norm(); }
+  /// Speed relative to the velocity @p common (m/s, map frame).
+  double speedRelativeTo(Point2 common) const { return std::hypot(x(2) - common.x, x(3) - common.y); }
   /// Standard deviation of the speed (along the velocity; the largest when the speed is near zero).
   double speedSigma() const;
   /// Seconds since the first association.
@@ -355,6 +379,7 @@ struct TrackerCounts
   std::uint64_t rejected_tracks = 0;    ///< deleted for a non-finite state or an implausible speed
   std::uint64_t fragments = 0;          ///< clusters that started no track: fragments of a moving track (step fragments)
   std::uint64_t duplicates = 0;         ///< moving tracks deleted as duplicates of another (step duplicates)
+  std::uint64_t common_motion_scans = 0;  ///< scans with a common motion (step common motion)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
@@ -427,6 +452,11 @@ public:
   const std::vector<Point2>& points() const { return map_points_; }
   const TrackerCounts& counts() const { return counts_; }
   const TrackerParams& params() const { return params_; }
+  /// Step common motion: the last scan's common motion (m/s, map frame), (0, 0) when it had none.
+  Point2 commonMotion() const { return common_motion_; }
+  bool hasCommonMotion() const { return has_common_motion_; }
+  /// The speed the motion decision takes: relative to the common motion.
+  double decisionSpeed(const Track& t) const { return t.speedRelativeTo(common_motion_); }
   /// Drops every track (ids keep counting up).
   void reset();
 
@@ -445,6 +475,8 @@ private:
   void dropDuplicates(std::vector<Track>& tracks, double stamp);
   /// Step hidden centre: each moving track seen this scan remembers the box it reports (Track::seen_box).
   void rememberSeenBoxes();
+  /// Step common motion: the common motion of the tracks seen at @p stamp (commonMotion()).
+  void findCommonMotion(double stamp);
 
   TrackerParams params_;
   std::vector<Track> tracks_;
@@ -454,6 +486,9 @@ private:
   std::vector<std::uint8_t> map_flags_;
   std::deque<SeenFree> seen_free_;  ///< the free space of the scans of the last free_space_time, oldest first
   bool free_now_ = false;           ///< seen_free_ holds this scan's (the check runs)
+  Point2 common_motion_;            ///< step common motion, m/s; (0, 0) when none
+  bool has_common_motion_ = false;
+  std::vector<double> common_vx_, common_vy_;  ///< its buffers
   TrackerCounts counts_;
   std::uint32_t next_id_ = 1;
   double last_stamp_ = -1.0;
