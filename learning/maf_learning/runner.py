@@ -68,20 +68,21 @@ class Drive:
         os.replace(partial, self.bag)
         return True
 
-    def scan_grid_config(self, config_dir):
-        """The sensor's ScanGrid file: config_dir/ibeo/ for the 4-layer IBEO when the directory has one."""
-        ibeo = os.path.join(config_dir, "ibeo", "scan_grid.yaml")
+    def sensor_config(self, config_dir, name):
+        """The sensor's file `name` (scan_grid.yaml, fusion.yaml): config_dir/ibeo/ for the 4-layer IBEO when the
+        directory has it, else config_dir/."""
+        ibeo = os.path.join(config_dir, "ibeo", name)
         if self.preset == "ibeo4" and os.path.isfile(ibeo):
             return ibeo
-        return os.path.join(config_dir, "scan_grid.yaml")
+        return os.path.join(config_dir, name)
 
     def evaluate(self, evaluate, config_dir, variant="default", timeout=600):
         """metrics.json's scores of `variant` (default: the configured method of config_dir; paper: the paper's)."""
         extra = ["--map", self.template["map_path"], "--origin", ",".join(str(v) for v in self.template["map_origin"])]
         if self.pose_covariance:
             extra += ["--pose-covariance-topic", "/localisation/pose"]
-        return run_evaluate(evaluate, self.bag, config_dir, self.scan_grid_config(config_dir), variant, self.name,
-                            timeout, extra)
+        return run_evaluate(evaluate, self.bag, config_dir, self.sensor_config(config_dir, "scan_grid.yaml"), variant,
+                            self.name, timeout, extra, fusion_config=self.sensor_config(config_dir, "fusion.yaml"))
 
 
 def _last_line(text):
@@ -89,10 +90,12 @@ def _last_line(text):
     return lines[-1] if lines else "no message"
 
 
-def run_evaluate(evaluate, bag, config_dir, scan_grid_config, variant, what, timeout, extra=()):
-    """`evaluate --only variant` of config_dir on bag (in a temporary folder): the variant's metrics.json scores."""
+def run_evaluate(evaluate, bag, config_dir, scan_grid_config, variant, what, timeout, extra=(), fusion_config=None):
+    """`evaluate --only variant` of config_dir on bag (in a temporary folder): the variant's metrics.json scores.
+    fusion_config: the fusion file (default config_dir/fusion.yaml)."""
     out_dir = tempfile.mkdtemp(prefix="maf_eval_")
-    cmd = [evaluate, "--bag", bag, "--out", out_dir, "--fusion-config", os.path.join(config_dir, "fusion.yaml"),
+    fusion_config = fusion_config or os.path.join(config_dir, "fusion.yaml")
+    cmd = [evaluate, "--bag", bag, "--out", out_dir, "--fusion-config", fusion_config,
            "--scan-grid-config", scan_grid_config, "--prior-config", os.path.join(config_dir, "prior_grid.yaml"),
            "--only", variant, "--no-ablations", "--quiet", *extra]
     try:

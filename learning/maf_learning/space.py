@@ -16,7 +16,8 @@ import yaml
 from .drives import PACKAGE_ROOT
 
 CONFIG_FILES = ("fusion.yaml", "scan_grid.yaml", "prior_grid.yaml")
-SENSOR_MARK = "IBEO:"  # lines of config/ibeo/scan_grid.yaml that belong to the sensor: never overridden
+SENSOR_MARK = "IBEO:"  # lines of config/ibeo/*.yaml that belong to the sensor: never overridden
+SENSOR_FILES = ("scan_grid.yaml", "fusion.yaml")  # the files of config/ibeo/
 _LINE = re.compile(r"^(?P<key>[A-Za-z_][A-Za-z0-9_]*):(?P<sp>\s*)(?P<value>[^#\n]*?)(?P<rest>\s*(#.*)?)$")
 
 
@@ -131,8 +132,8 @@ def render(base_text, values, keep_sensor_lines=False):
 
 
 def write_config_dir(out_dir, values_by_file, config_dir=None, header=None):
-    """Writes out_dir/{fusion,scan_grid,prior_grid}.yaml and out_dir/ibeo/scan_grid.yaml from config_dir (config/
-    by default) with the values substituted (the IBEO file keeps its sensor lines)."""
+    """Writes out_dir/{fusion,scan_grid,prior_grid}.yaml and out_dir/ibeo/{scan_grid,fusion}.yaml from config_dir
+    (config/ by default) with the values substituted (the IBEO files keep their sensor lines)."""
     config_dir = config_dir or os.path.join(PACKAGE_ROOT, "config")
     os.makedirs(os.path.join(out_dir, "ibeo"), exist_ok=True)
     for name in CONFIG_FILES:
@@ -140,13 +141,14 @@ def write_config_dir(out_dir, values_by_file, config_dir=None, header=None):
             text = render(f.read(), values_by_file.get(name, {}))
         with open(os.path.join(out_dir, name), "w") as f:
             f.write((header or "") + text)
-    ibeo_base = os.path.join(config_dir, "ibeo", "scan_grid.yaml")
-    if not os.path.isfile(ibeo_base):
-        ibeo_base = os.path.join(PACKAGE_ROOT, "config", "ibeo", "scan_grid.yaml")
-    with open(ibeo_base) as f:
-        text = render(f.read(), values_by_file.get("scan_grid.yaml", {}), keep_sensor_lines=True)
-    with open(os.path.join(out_dir, "ibeo", "scan_grid.yaml"), "w") as f:
-        f.write((header or "") + text)
+    for name in SENSOR_FILES:
+        ibeo_base = os.path.join(config_dir, "ibeo", name)
+        if not os.path.isfile(ibeo_base):
+            ibeo_base = os.path.join(PACKAGE_ROOT, "config", "ibeo", name)
+        with open(ibeo_base) as f:
+            text = render(f.read(), values_by_file.get(name, {}), keep_sensor_lines=True)
+        with open(os.path.join(out_dir, "ibeo", name), "w") as f:
+            f.write((header or "") + text)
 
 
 def split_values(flat):
@@ -159,15 +161,21 @@ def split_values(flat):
 
 
 def check_config_dir(evaluate, config_dir):
-    """None when `evaluate --check-config` accepts the directory, else its one-line error."""
-    cmd = [evaluate, "--check-config", "--fusion-config", os.path.join(config_dir, "fusion.yaml"),
-           "--scan-grid-config", os.path.join(config_dir, "scan_grid.yaml"),
-           "--prior-config", os.path.join(config_dir, "prior_grid.yaml")]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
-    if r.returncode == 0:
-        return None
-    lines = [ln.strip() for ln in r.stderr.splitlines() if ln.strip()]
-    return (lines[-1] if lines else f"exit {r.returncode}").replace("evaluate: ", "")
+    """None when `evaluate --check-config` accepts the directory (and its ibeo/ files, when it has them), else its
+    one-line error."""
+    sensor = os.path.join(config_dir, "ibeo")
+    sets = [(config_dir, config_dir)]
+    if all(os.path.isfile(os.path.join(sensor, n)) for n in SENSOR_FILES):
+        sets.append((sensor, sensor))
+    for fusion_dir, scan_dir in sets:
+        cmd = [evaluate, "--check-config", "--fusion-config", os.path.join(fusion_dir, "fusion.yaml"),
+               "--scan-grid-config", os.path.join(scan_dir, "scan_grid.yaml"),
+               "--prior-config", os.path.join(config_dir, "prior_grid.yaml")]
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
+        if r.returncode != 0:
+            lines = [ln.strip() for ln in r.stderr.splitlines() if ln.strip()]
+            return (lines[-1] if lines else f"exit {r.returncode}").replace("evaluate: ", "")
+    return None
 
 
 def validate_ranges(params, evaluate, config_dir=None):

@@ -362,7 +362,7 @@ def report(setup, log=print):
               f"training drives\n# {', '.join(study.user_attrs.get('training_drives', []))}); "
               "every other key as in config/. doc/learning.md.\n")
     sp.write_config_dir(learned_dir, values, setup.config, header)
-    log(f"wrote {learned_dir}/ (fusion, scan_grid, prior_grid, ibeo/scan_grid) from trial #{best.number}")
+    log(f"wrote {learned_dir}/ (fusion, scan_grid, prior_grid, ibeo/scan_grid, ibeo/fusion) from trial #{best.number}")
     dirs = {"paper": (os.path.join(setup.config, "paper"), "paper"), "default": (setup.config, "default"),
             "learned": (learned_dir, "default")}
     for rule in ("yager", "dempster"):

@@ -101,6 +101,9 @@ def test_report_writes_the_learned_profile_and_the_table(study_dir, tools):
     ibeo = yaml.safe_load((out / "ibeo" / "scan_grid.yaml").read_text())
     assert ibeo["ground_model"] == "flat" and ibeo["relative_height_limit"] == 0.0  # the sensor's lines kept
     assert ibeo["mu_free"] == pytest.approx(best.params["scan_grid.mu_free"], abs=1e-6)
+    ibeo_fusion = yaml.safe_load((out / "ibeo" / "fusion.yaml").read_text())
+    assert ibeo_fusion["tracker_min_cluster_points"] == 4  # the sensor's line kept
+    assert ibeo_fusion["alpha_dynamic"] == pytest.approx(best.params["fusion.alpha_dynamic"], abs=1e-6)
     assert space.check_config_dir(tools["evaluate"], str(out)) is None
     text = table.read_text()
     for row in ("| training | paper's method", "| held-out | learned profile", "Dempster's rule", "Held-out verdict",
@@ -203,6 +206,9 @@ def test_refresh_profile_renders_the_learned_values_over_the_current_configurati
     ibeo = yaml.safe_load((prof / "ibeo" / "scan_grid.yaml").read_text())
     assert ibeo["ground_model"] == "flat" and ibeo["relative_height_limit"] == 0.0  # the sensor's lines kept
     assert ibeo["mu_free"] == pytest.approx(learned_before["scan_grid.yaml"]["mu_free"], abs=1e-6)
+    ibeo_fusion = yaml.safe_load((prof / "ibeo" / "fusion.yaml").read_text())
+    assert ibeo_fusion["tracker_min_cluster_points"] == 4  # the sensor's line kept
+    assert ibeo_fusion["alpha_dynamic"] == pytest.approx(learned_before["fusion.yaml"]["alpha_dynamic"], abs=1e-6)
     assert space.check_config_dir(tools["evaluate"], str(prof)) is None
 
 

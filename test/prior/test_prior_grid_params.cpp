@@ -236,10 +236,43 @@ TEST(Profiles, IbeoScanGridDiffersFromTheDefaultOnlyWhereTheSensorNeedsIt)
   EXPECT_EQ(ibeo.grid_size_x, 100.0) << "the paper's window";
 }
 
+namespace {
+
+/// The parameters whose values differ between @p x and @p y.
+template <class Params>
+std::set<std::string> differing(const Params& x, const Params& y)
+{
+  const auto a = valuesOf(x), b = valuesOf(y);
+  std::set<std::string> out;
+  for (const auto& kv : a)
+    if (b.at(kv.first) != kv.second) out.insert(kv.first);
+  return out;
+}
+
+}  // namespace
+
+// config/ibeo/fusion.yaml is config/fusion.yaml but for the tracker's smallest cluster: four layers give an object a
+// few returns per column.
+TEST(Profiles, IbeoFusionDiffersFromTheDefaultOnlyInTheSmallestCluster)
+{
+  const std::string dir = std::string(MAF_PACKAGE_DIR) + "/config/";
+  const core::Profile def = core::defaultProfile();
+  const core::MapGridParams grid = loadFile<core::MapGridParams>(dir + "ibeo/fusion.yaml");
+  const core::TrackerParams tracker = loadFile<core::TrackerParams>(dir + "ibeo/fusion.yaml");
+  EXPECT_NO_THROW(grid.validate());
+  EXPECT_NO_THROW(tracker.validate());
+  EXPECT_TRUE(differing(grid, def.map_grid).empty());
+  EXPECT_EQ(differing(tracker, def.tracker), (std::set<std::string>{ "tracker_min_cluster_points" }));
+  EXPECT_EQ(tracker.min_cluster_points, 4);
+  const YAML::Node base = YAML::LoadFile(dir + "fusion.yaml"), ibeo = YAML::LoadFile(dir + "ibeo/fusion.yaml");
+  EXPECT_EQ(base.size(), ibeo.size()) << "every key of config/fusion.yaml, and no other";
+  for (const auto& kv : base) EXPECT_TRUE(ibeo[kv.first.as<std::string>()].IsDefined()) << kv.first.as<std::string>();
+}
+
 TEST(Profiles, LearnedProfileIsCompleteValidAndKeepsTheIbeoSensorLines)
 {
   // config/learned/ is written by `learning/tune --report`: every key of config/, validated, and its IBEO ScanGrid
-  // differs from its ScanGrid only where the sensor needs it.
+  // and fusion differ from its ScanGrid and fusion only where the sensor needs it.
   const std::string dir = std::string(MAF_PACKAGE_DIR) + "/config/learned/";
   const core::MapGridParams fusion = loadFile<core::MapGridParams>(dir + "fusion.yaml");
   EXPECT_NO_THROW(fusion.validate());
@@ -248,20 +281,22 @@ TEST(Profiles, LearnedProfileIsCompleteValidAndKeepsTheIbeoSensorLines)
   EXPECT_NO_THROW(scan.validate());
   EXPECT_NO_THROW(ibeo.validate());
   // Where config/ibeo/ differs from config/ (the sensor's lines), and nowhere else.
-  auto differing = [](const core::ScanGridParams& x, const core::ScanGridParams& y) {
-    const auto a = valuesOf(x), b = valuesOf(y);
-    std::set<std::string> out;
-    for (const auto& kv : a)
-      if (b.at(kv.first) != kv.second) out.insert(kv.first);
-    return out;
-  };
   const std::string config = std::string(MAF_PACKAGE_DIR) + "/config/";
   const std::set<std::string> sensor = differing(loadFile<core::ScanGridParams>(config + "ibeo/scan_grid.yaml"),
                                                  loadFile<core::ScanGridParams>(config + "scan_grid.yaml"));
   EXPECT_TRUE(sensor.count("ground_model") && sensor.count("azimuth_resolution_deg"));
   EXPECT_EQ(differing(ibeo, scan), sensor);
+  const core::MapGridParams ibeo_fusion = loadFile<core::MapGridParams>(dir + "ibeo/fusion.yaml");
+  const core::TrackerParams tracker = loadFile<core::TrackerParams>(dir + "fusion.yaml");
+  const core::TrackerParams ibeo_tracker = loadFile<core::TrackerParams>(dir + "ibeo/fusion.yaml");
+  EXPECT_NO_THROW(ibeo_fusion.validate());
+  EXPECT_NO_THROW(ibeo_tracker.validate());
+  EXPECT_TRUE(differing(ibeo_fusion, fusion).empty()) << "the learned fusion values in the IBEO file too";
+  EXPECT_EQ(differing(ibeo_tracker, tracker),
+            differing(loadFile<core::TrackerParams>(config + "ibeo/fusion.yaml"),
+                      loadFile<core::TrackerParams>(config + "fusion.yaml")));
   // Every key of config/ (`learning/tune --refresh-profile` re-renders a profile when config/ gains keys).
-  for (const char* f : { "fusion.yaml", "scan_grid.yaml", "prior_grid.yaml", "ibeo/scan_grid.yaml" })
+  for (const char* f : { "fusion.yaml", "scan_grid.yaml", "prior_grid.yaml", "ibeo/scan_grid.yaml", "ibeo/fusion.yaml" })
   {
     const YAML::Node base = YAML::LoadFile(config + f), learned = YAML::LoadFile(dir + f);
     for (const auto& kv : base)
