@@ -198,8 +198,9 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
                   background);
   tracker.update(stamp, pose, returns, &background, scan);
   std::vector<CellMotion> cells = trackEvidence(tracker, g);
-  if (!prior && p.evidence_small_without_map)
-    for (CellMotion& c : cells) c.take_c = c.take_n;
+  if (!prior && p.evidence_without_map)
+    for (CellMotion& c : cells)
+      if (c.motion == CellClass::kMoving && (c.take_n || !c.interior)) c.take_n = c.take_c = true;
   if (scan && tracker.params().evidence_box_hidden) markHidden(cells, g, *scan, pose);
   grid.applyTrackedMotion(cells);
 }

@@ -559,7 +559,7 @@ TEST(MotionSteps, SmallMoverCellsAlsoGiveTheirSetsHoldingN)
   EXPECT_EQ(with.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
 }
 
-// Step "small movers without a map": without a prior an occupied cell holds the scan's O = {C, N, S, V}; the cells of
+// Step "movers without a map": without a prior an occupied cell holds the scan's O = {C, N, S, V}; the cells of
 // a small moving track with CellMotion::take_c also give the sets holding C (here Ω and {C, N, S, V}) to V, half of
 // each at β = 0.5; with take_n alone those keep their mass.
 TEST(MotionSteps, SmallMoverCellsWithoutAMapAlsoGiveTheirSetsHoldingC)
@@ -596,61 +596,78 @@ TEST(MotionSteps, SmallMoverCellsWithoutAMapAlsoGiveTheirSetsHoldingC)
   EXPECT_NE(without.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
 }
 
-// The same step through trackScan(): a pedestrian walking at 1.5 m/s across open ground, tracked scan by scan. On the
-// last scan, in every cell of its track evidence (a small mover's), the sets holding C keep 1 − β of their mass
-// without a prior, and all of it with the step off or with a prior (a pavement: trackScan() sets no take_c).
-TEST(MotionSteps, TrackScanLetsASmallMoverTakeCOnlyWithoutAPrior)
+// The same step through trackScan(): a pedestrian walking at 1.5 m/s and a car driving at 8 m/s across open ground,
+// tracked scan by scan. On the last scan, in every cell of the track's evidence that the step covers (a small mover's
+// cells, a larger mover's return cells, not its box cells), the sets holding V and C (the car's: C or N) keep 1 − β of
+// their mass without a prior; they keep all of it with the step off, with a prior (a pavement: trackScan() sets no
+// take_c), and in the car's box cells.
+TEST(MotionSteps, TrackScanLetsAMoverTakeCAndNOnlyWithoutAPrior)
 {
   constexpr int kScans = 20;
-  constexpr double kSpeed = 1.5;
+  struct Mover
+  {
+    const char* what;
+    double speed, length, width;
+    bool small;
+  };
   struct Case
   {
     bool step, with_prior;
   };
-  for (const Case c : { Case{ true, false }, Case{ false, false }, Case{ true, true } })
-  {
-    Profile profile = defaultProfile();
-    profile.tracker.evidence_small_without_map = c.step;
-    core::Run run(profile);
-    const GridGeometry& g = run.grid.geometry();
-    PriorWindow pavement;
-    pavement.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
-    std::fill(pavement.other.begin(), pavement.other.end(), 0.85f);
-    const PriorWindow* prior = c.with_prior ? &pavement : nullptr;
-    Tracker tracker(profile.tracker);
-    std::vector<std::uint8_t> background;
-    MapGrid before(profile.map_grid);
-    for (int k = 0; k < kScans; ++k)
+  for (const Mover mover : { Mover{ "pedestrian", 1.5, 0.5, 0.5, true }, Mover{ "car", 8.0, 4.0, 1.8, false } })
+    for (const Case c : { Case{ true, false }, Case{ false, false }, Case{ true, true } })
     {
-      const double x = 8.0 + kSpeed * kScanPeriod * k;
-      World world;
-      world.boxes.push_back({ x, 3.0, x + 0.5, 3.5, 1.7 });
-      run.step(world, Pose2{ 0.0, 0.0, 0.0 }, prior);
-      if (k + 1 == kScans) before = run.grid;
-      trackScan(tracker, run.grid, kScanPeriod * run.scans, Pose2{ 0.0, 0.0, 0.0 }, run.builder.obstaclePoints(),
-                background, &run.scan, prior);
+      const std::string what = std::string(mover.what) + ", step " + (c.step ? "on" : "off") +
+                               (c.with_prior ? ", with a prior" : ", no prior");
+      Profile profile = defaultProfile();
+      profile.tracker.evidence_without_map = c.step;
+      core::Run run(profile);
+      const GridGeometry& g = run.grid.geometry();
+      PriorWindow pavement;
+      pavement.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
+      std::fill(pavement.other.begin(), pavement.other.end(), 0.85f);
+      const PriorWindow* prior = c.with_prior ? &pavement : nullptr;
+      Tracker tracker(profile.tracker);
+      std::vector<std::uint8_t> background;
+      MapGrid before(profile.map_grid);
+      for (int k = 0; k < kScans; ++k)
+      {
+        const double x = 8.0 + mover.speed * kScanPeriod * k;
+        World world;
+        world.boxes.push_back({ x, 3.0, x + mover.length, 3.0 + mover.width, 1.7 });
+        run.step(world, Pose2{ 0.0, 0.0, 0.0 }, prior);
+        if (k + 1 == kScans) before = run.grid;
+        trackScan(tracker, run.grid, kScanPeriod * run.scans, Pose2{ 0.0, 0.0, 0.0 }, run.builder.obstaclePoints(),
+                  background, &run.scan, prior);
+      }
+      ASSERT_EQ(tracker.tracks().size(), 1u) << what;
+      ASSERT_EQ(tracker.tracks()[0].motion, TrackMotion::kMoving) << what;
+      const std::vector<CellMotion> cells = trackEvidence(tracker, g);
+      ASSERT_FALSE(cells.empty()) << what;
+      // A small mover's sets holding N move with any prior (step small movers): those holding C are this step's.
+      const Subset static_step = mover.small ? FrameMG::kC : (FrameMG::kC | FrameMG::kN);
+      double holding = 0.0;
+      int covered = 0;
+      for (const CellMotion& m : cells)
+      {
+        ASSERT_EQ(m.take_n, mover.small) << what;
+        ASSERT_GT(m.weight, 0.5f) << what;
+        const bool takes = c.step && !c.with_prior && (mover.small || !m.interior);
+        covered += takes;
+        const std::vector<float> was = massesOf(before, m.cell), is = massesOf(run.grid, m.cell);
+        for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
+          if ((a & static_step) && (a & FrameMG::kV))
+          {
+            holding += was[a];
+            EXPECT_NEAR(is[a], takes ? (1.0f - m.weight) * was[a] : was[a], 1e-6) << subsetName<FrameMG>(a) << ", " << what;
+          }
+      }
+      EXPECT_GT(holding, 0.1) << "the cells held mass on sets holding C or N, " << what;
+      if (c.step && !c.with_prior)
+      {
+        EXPECT_GT(covered, 0) << what;
+      }
     }
-    ASSERT_EQ(tracker.tracks().size(), 1u);
-    ASSERT_EQ(tracker.tracks()[0].motion, TrackMotion::kMoving);
-    const std::vector<CellMotion> cells = trackEvidence(tracker, g);
-    ASSERT_FALSE(cells.empty());
-    const bool takes_c = c.step && !c.with_prior;
-    double holding_c = 0.0;
-    for (const CellMotion& m : cells)
-    {
-      ASSERT_TRUE(m.take_n);
-      ASSERT_GT(m.weight, 0.5f);
-      const std::vector<float> was = massesOf(before, m.cell), is = massesOf(run.grid, m.cell);
-      for (Subset a = 1; a < FrameMG::kNumSubsets; ++a)
-        if ((a & FrameMG::kC) && (a & FrameMG::kV))
-        {
-          holding_c += was[a];
-          EXPECT_NEAR(is[a], takes_c ? (1.0f - m.weight) * was[a] : was[a], 1e-6)
-              << subsetName<FrameMG>(a) << ", step " << c.step << ", prior " << c.with_prior;
-        }
-    }
-    EXPECT_GT(holding_c, 0.1) << "the cells held mass on sets holding C";
-  }
 }
 
 // priorBetPBuilding() is BetP(C) of the prior's mass function (pignistic() of PriorWindow::cell()), on cells of every

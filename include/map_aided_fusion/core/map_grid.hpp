@@ -189,7 +189,7 @@ struct CellMotion
   bool hidden = false;
   /// Sets holding N move too (step "small movers"): a pedestrian on a pavement whose prior is {N, S, V}.
   bool take_n = false;
-  /// Sets holding C move too (step small movers without a map: without a prior, C is not told from N, S and V).
+  /// Sets holding C move too (step movers without a map: without a prior, C is not told from N, S and V).
   bool take_c = false;
 };
 

@@ -56,8 +56,9 @@ float priorBetPBuilding(const PriorWindow& prior, std::size_t i);
  *        priorBetPBuilding(), when given), updates @p tracker with the scan's ScanGrid @p scan (vehicle frame; the
  *        free space of step free-space check, nullptr: none), and applies its evidence to @p grid
  *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan; @p prior is
- *        the prior the grid's update() fused (nullptr: none). Without a prior, with step small movers without a map,
- *        a small mover's cells (CellMotion::take_n) also take C (CellMotion::take_c).
+ *        the prior the grid's update() fused (nullptr: none). Without a prior, with step movers without a map, the
+ *        cells of a moving track's returns and a small mover's box cells also take N and C (CellMotion::take_n,
+ *        take_c).
  */
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
                std::vector<std::uint8_t>& background, const ScanMassGrid* scan = nullptr,

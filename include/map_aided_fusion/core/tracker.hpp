@@ -155,9 +155,10 @@ struct TrackerParams
   double common_motion_share = 0.5;      ///< in (0, 1]
   double common_motion_sigmas = 2.0;     ///< σ(speed) of a track from the median that still agrees with it
   double common_motion_max_speed = 2.0;  ///< m/s
-  /// Step "small movers without a map": without a prior the grid never tells C from the other occupied classes (the
-  /// scan's O is {C, N, S, V}), so a small mover's cells (step small movers) also move to V the sets holding C.
-  bool evidence_small_without_map = true;
+  /// Step "movers without a map": without a prior the grid never tells C and N from S and V (the scan's O is
+  /// {C, N, S, V}), so the cells of a moving track's returns, and the box cells of a small mover (step small movers),
+  /// also move to V the sets holding C or N. With a prior, C and N are the map's and the counter's and stay.
+  bool evidence_without_map = true;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -220,7 +221,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_common_motion_share", p.common_motion_share, { "", "share of those tracks that must agree with the median velocity" });
   get("tracker_common_motion_sigmas", p.common_motion_sigmas, { "", "a track agrees with the median when within this many σ(speed) of it" });
   get("tracker_common_motion_max_speed", p.common_motion_max_speed, { "m/s", "a faster median is traffic, not a drift: no common motion" });
-  get("tracker_evidence_small_without_map", p.evidence_small_without_map, { "", "step small movers without a map: without a prior a small mover's cells also move the sets holding C to V" });
+  get("tracker_evidence_without_map", p.evidence_without_map, { "", "step movers without a map: without a prior a moving track's return cells (and a small mover's box) also move the sets holding C or N to V" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
