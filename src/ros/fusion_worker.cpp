@@ -216,11 +216,21 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
   }
   std::lock_guard<std::mutex> lock(mutex_);
   softener_.setPrior(prior);
+  // Softened now, for the σ in force, rather than in the next scan's callback (hundreds of ms for a large map at
+  // 0.2 m); that scan recomputes only if σ changes before it, exactly as it would have.
+  bool softened = false;
+  softener_.softened(priorSigma(), &softened);
+  if (softened) ++counters_.prior_softenings;
 #ifdef __GLIBC__
   malloc_trim(0);  // the previous prior (possibly a huge map's) is freed: give its pages back
 #endif
   ROS_INFO_STREAM("fusion: prior grid " << prior->geometry.width << "x" << prior->geometry.height << " cells at "
                                         << prior->geometry.resolution << " m");
+}
+
+double FusionWorker::priorSigma() const
+{
+  return std::isnan(covariance_sigma_) ? grid_.params().position_sigma : covariance_sigma_;
 }
 
 void FusionWorker::onCovariance(const boost::array<double, 36>& covariance)
@@ -507,9 +517,8 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
                                                       "still covers it");
     }
   }
-  const double sigma = std::isnan(covariance_sigma_) ? grid_.params().position_sigma : covariance_sigma_;
   bool softened = false;
-  const core::PriorWindow* prior = softener_.softened(sigma, &softened);
+  const core::PriorWindow* prior = softener_.softened(priorSigma(), &softened);
   if (softened) ++counters_.prior_softenings;
   if (!prior && !warned_no_prior_)
   {

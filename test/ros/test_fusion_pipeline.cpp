@@ -123,6 +123,10 @@ TEST_F(PipelineTest, CarCrossingIsMovingDropsAreCountedTimeJumpsReset)
   for (int i = 0; i < 300 && points_pub_.getNumSubscribers() == 0; ++i) spinFor(0.1);
   ASSERT_GT(points_pub_.getNumSubscribers(), 0u) << "nobody subscribes to points";
   spinFor(2.0);  // prior loaded and latched
+  // The prior is softened when it arrives, not in the first scan's callback, and once while σ stays the same.
+  for (int i = 0; i < 100 && diagnostic("prior softenings") < 1.0; ++i) spinFor(0.1);
+  EXPECT_EQ(diagnostic("prior softenings"), 1.0) << "the prior was not softened on arrival";
+  EXPECT_EQ(diagnostic("scans fused"), 0.0);
 
   const ros::Time t0 = ros::Time::now();
   double car_x = -18.0;
@@ -142,6 +146,7 @@ TEST_F(PipelineTest, CarCrossingIsMovingDropsAreCountedTimeJumpsReset)
     spinFor(kScanPeriod);
   }
   spinFor(1.5);
+  EXPECT_EQ(diagnostic("prior softenings"), 1.0) << "the prior was softened again with the same sigma";
 
   {
     std::lock_guard<std::mutex> lock(mutex_);
