@@ -89,6 +89,9 @@ const std::vector<AddedStep>& addedSteps()
     { "common_motion", "when many confirmed tracks agree on one slow velocity (a drifting pose), motion is decided relative to it",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.common_motion; },
       [](Profile& p) { p.tracker.common_motion = false; } },
+    { "across_face", "a track seen in every one of its last scans that moves across its cluster's face has shown its motion as free space would",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.across_face; },
+      [](Profile& p) { p.tracker.across_face = false; } },
   };
   return steps;
 }

@@ -89,6 +89,10 @@ void TrackerParams::validate() const
   requireInRange("tracker_common_motion_share", common_motion_share, kMinShare, 1.0);
   requireInRange("tracker_common_motion_sigmas", common_motion_sigmas, 0.0, 10.0);
   requireInRange("tracker_common_motion_max_speed", common_motion_max_speed, 0.0, max_speed);
+  requireInRange("tracker_across_min_hits", across_min_hits, 1, 100000);
+  requireInRange("tracker_across_min_length", across_min_length, 0.0, max_object_length);
+  requireInRange("tracker_across_max_width_share", across_max_width_share, kMinShare, 1.0);
+  requireInRange("tracker_across_sigmas", across_sigmas, 0.0, 10.0);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -532,6 +536,18 @@ bool Tracker::smallWalker(const Track& t) const
          t.extent_width >= least && t.speed() <= params_.free_space_small_max_speed;
 }
 
+bool Tracker::movesAcrossFace(const Track& t) const
+{
+  if (t.state == TrackState::kTentative || t.measurement < 0) return false;
+  if (t.consecutive_hits < params_.across_min_hits) return false;
+  const Measurement& m = measurements_[t.measurement];
+  if (m.length < params_.across_min_length || m.width > params_.across_max_width_share * m.length) return false;
+  const Eigen::Vector2d across(-std::sin(m.yaw), std::cos(m.yaw));
+  const double speed = std::abs((t.x(2) - common_motion_.x) * across.x() + (t.x(3) - common_motion_.y) * across.y());
+  const double sigma = std::sqrt(std::max(0.0, across.dot(t.P.bottomRightCorner<2, 2>() * across)));
+  return speed - params_.across_sigmas * sigma > params_.moving_speed;
+}
+
 void Tracker::seeFreeSpace(Track& t, double stamp)
 {
   if (t.measurement < 0) return;
@@ -560,6 +576,11 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     const auto came = std::count_if(now.points.begin(), now.points.end(), seenFreeBefore);
     t.motion_seen = left || (!now.points.empty() && static_cast<double>(came) >=
                                                         params_.free_space_share * static_cast<double>(now.points.size()));
+    if (!t.motion_seen && params_.across_face && movesAcrossFace(t))
+    {
+      t.motion_seen = true;
+      ++counts_.across_face;
+    }
   }
   const double oldest = stamp - params_.free_space_time - kMinStep;
   t.sightings.erase(std::remove_if(t.sightings.begin(), t.sightings.end(),

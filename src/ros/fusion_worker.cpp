@@ -751,6 +751,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     else
       status.add("common motion (last scan) [m/s]", "none");
     status.add("scans with a common motion", c.common_motion_scans);
+    status.add("tracks whose motion was seen across their face", c.across_face);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }
 }

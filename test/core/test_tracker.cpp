@@ -1346,3 +1346,102 @@ TEST(Tracker, CommonMotionParametersAreValidatedByName)
       { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = -0.1; } },
       { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = 1e3; } } });
 }
+
+namespace {
+
+/// Step across its face, on a sensor that never sees free space: the first scan (-1: never within 2.5 s) from which
+/// the track of @p points_at(k) (the returns of scan k, none when empty) is moving, and the step's count.
+template <class PointsAt>
+int movingFromWithoutFreeSpace(const TrackerParams& params, PointsAt&& points_at, std::uint64_t* across = nullptr)
+{
+  Tracker tracker(params);
+  int from = -1;
+  for (int k = 0; k < 25; ++k)
+  {
+    const std::vector<float> xy = flatten(points_at(k));
+    const ScanMassGrid scan = scanGrid(xy, [](Point2) { return false; });
+    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, &scan);
+    EXPECT_LE(tracker.tracks().size(), 1u) << "scan " << k;
+    for (const Track& t : tracker.tracks())
+      if (t.motion == TrackMotion::kMoving && from < 0) from = k;
+  }
+  if (across) *across = tracker.counts().across_face;
+  return from;
+}
+
+/// Returns on a face 1.7 m long across x (a car's end seen end-on) at x, two rows 0.1 m apart, every 0.1 m.
+std::vector<Point2> endFace(double x)
+{
+  std::vector<Point2> out;
+  for (double y = -0.85; y <= 0.85 + 1e-9; y += 0.1)
+  {
+    out.push_back(Point2{ x, 5.0 + y });
+    out.push_back(Point2{ x + 0.1, 5.0 + y });
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Tracker, AcrossFaceSeesACarEndOnWhoseRoadIsHidden)
+{
+  // A car followed end-on at 6 m/s beyond a lead car that hides the road around it: free space never shows it move.
+  const auto car = [](int k) { return endFace(10.0 + 0.6 * k); };
+  TrackerParams on;
+  ASSERT_TRUE(on.across_face);
+  std::uint64_t across = 0;
+  EXPECT_EQ(movingFromWithoutFreeSpace(on, car, &across), on.across_min_hits - 1)
+      << "moving at the scan of its across_min_hits-th consecutive association";
+  EXPECT_EQ(across, 1u);
+  TrackerParams off = on;
+  off.across_face = false;
+  EXPECT_EQ(movingFromWithoutFreeSpace(off, car, &across), -1) << "the free-space check alone never sees it move";
+  EXPECT_EQ(across, 0u);
+  TrackerParams fewer = on;
+  fewer.across_min_hits = 8;
+  EXPECT_EQ(movingFromWithoutFreeSpace(fewer, car), 7);
+  // Missing one scan in five, it is never associated in across_min_hits consecutive scans.
+  const auto hopping = [&](int k) { return k % 5 == 4 ? std::vector<Point2>{} : car(k); };
+  EXPECT_EQ(movingFromWithoutFreeSpace(on, hopping, &across), -1);
+  EXPECT_EQ(across, 0u);
+}
+
+TEST(Tracker, AcrossFaceLeavesWhatMovesAlongItselfOrIsNoFace)
+{
+  TrackerParams on;
+  std::uint64_t across = 0;
+  // The visible 4 m of a wall along x, sliding along itself at 6 m/s as the view changes.
+  const auto wall = [](int k) {
+    std::vector<Point2> out;
+    for (double u = 0.0; u <= 4.0 + 1e-9; u += 0.1)
+    {
+      out.push_back(Point2{ 0.6 * k + u, 15.1 });
+      out.push_back(Point2{ 0.6 * k + u, 15.2 });
+    }
+    return out;
+  };
+  EXPECT_EQ(movingFromWithoutFreeSpace(on, wall, &across), -1);
+  EXPECT_EQ(across, 0u);
+  // A 4 × 2 m car's outline (no face: its width is half its length) moving at 6 m/s across its length.
+  const auto box = [](int k) { return boxOutline(5.0, -10.0 + 0.6 * k, 0.0, 4.0, 2.0); };
+  EXPECT_EQ(movingFromWithoutFreeSpace(on, box, &across), -1);
+  EXPECT_EQ(across, 0u);
+  TrackerParams any_width = on;
+  any_width.across_max_width_share = 1.0;
+  EXPECT_EQ(movingFromWithoutFreeSpace(any_width, box, &across), on.across_min_hits - 1) << "as a face, it would move";
+  // A face that does not move.
+  EXPECT_EQ(movingFromWithoutFreeSpace(on, [](int) { return endFace(10.0); }, &across), -1);
+  EXPECT_EQ(across, 0u);
+}
+
+TEST(Tracker, AcrossFaceParametersAreValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_across_min_hits", [](TrackerParams& p) { p.across_min_hits = 0; } },
+      { "tracker_across_min_length", [](TrackerParams& p) { p.across_min_length = -0.1; } },
+      { "tracker_across_min_length", [](TrackerParams& p) { p.across_min_length = std::nan(""); } },
+      { "tracker_across_max_width_share", [](TrackerParams& p) { p.across_max_width_share = 0.0; } },
+      { "tracker_across_max_width_share", [](TrackerParams& p) { p.across_max_width_share = 1.5; } },
+      { "tracker_across_sigmas", [](TrackerParams& p) { p.across_sigmas = -1.0; } },
+      { "tracker_across_sigmas", [](TrackerParams& p) { p.across_sigmas = 11.0; } } });
+}

@@ -159,6 +159,18 @@ struct TrackerParams
   /// {C, N, S, V}), so the cells of a moving track's returns, and the box cells of a small mover (step small movers),
   /// also move to V the sets holding C or N. With a prior, C and N are the map's and the counter's and stay.
   bool evidence_without_map = true;
+  /// Step "across its face" (free-space check): a static structure seen from a moving sensor can seem to move, but only
+  /// along itself (the visible part of a wall or a fence slides as the view changes). A track associated in each of
+  /// its last across_min_hits scans, whose cluster this scan is a face (at least across_min_length long, its width at
+  /// most across_max_width_share of that) and whose velocity across that face, relative to the common motion, clears
+  /// moving_speed by across_sigmas σ has shown its motion as the free-space check would (Track::motion_seen): a car
+  /// seen end-on beyond the car ahead, whose road the lead car hides. A track hopping from one parked car's end to the
+  /// next as the sensor passes a row of them also seems to move across their faces, but it misses scans while it hops.
+  bool across_face = true;
+  int across_min_hits = 15;             ///< consecutive associations
+  double across_min_length = 1.0;       ///< m
+  double across_max_width_share = 0.3;  ///< (0, 1]
+  double across_sigmas = 3.0;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -222,6 +234,11 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_common_motion_sigmas", p.common_motion_sigmas, { "", "a track agrees with the median when within this many σ(speed) of it" });
   get("tracker_common_motion_max_speed", p.common_motion_max_speed, { "m/s", "a faster median is traffic, not a drift: no common motion" });
   get("tracker_evidence_without_map", p.evidence_without_map, { "", "step movers without a map: without a prior a moving track's return cells (and a small mover's box) also move the sets holding C or N to V" });
+  get("tracker_across_face", p.across_face, { "", "step across its face: a track moving across its cluster's face (a car seen end-on) has shown its motion as the free-space check would" });
+  get("tracker_across_min_hits", p.across_min_hits, { "scans", "consecutive associations a track needs before step across its face" });
+  get("tracker_across_min_length", p.across_min_length, { "m", "shortest cluster that is a face" });
+  get("tracker_across_max_width_share", p.across_max_width_share, { "", "largest width of a face, as a share of its length" });
+  get("tracker_across_sigmas", p.across_sigmas, { "", "standard deviations by which the speed across the face must clear tracker_moving_speed" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -381,6 +398,7 @@ struct TrackerCounts
   std::uint64_t fragments = 0;          ///< clusters that started no track: fragments of a moving track (step fragments)
   std::uint64_t duplicates = 0;         ///< moving tracks deleted as duplicates of another (step duplicates)
   std::uint64_t common_motion_scans = 0;  ///< scans with a common motion (step common motion)
+  std::uint64_t across_face = 0;  ///< tracks whose motion was seen across their face (step across its face)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
@@ -471,6 +489,8 @@ private:
   bool fastEnough(const Track& t, double sigmas) const;
   /// Step small free space: @p t is checked with free_space_small_margin.
   bool smallWalker(const Track& t) const;
+  /// Step across its face: @p t's cluster this scan is a face and its velocity across it is significant.
+  bool movesAcrossFace(const Track& t) const;
   /// Step duplicates: deletes from @p tracks the duplicates of moving tracks seen at @p stamp; their clusters become
   /// the kept tracks' fragments.
   void dropDuplicates(std::vector<Track>& tracks, double stamp);
