@@ -923,8 +923,10 @@ void MapGrid::applyTrackedMotion(const std::vector<CellMotion>& cells)
     // pole must not take its N); a small mover's (take_n) also within {F, N, S, V}, and without a map (take_c) any.
     const unsigned dynamic =
         FrameMG::kF | FrameMG::kS | FrameMG::kV | (c.take_n ? FrameMG::kN : 0u) | (c.take_c ? FrameMG::kC : 0u);
-    // Sets within {F, other} go to the target, except in a box cell the scan saw free.
-    const unsigned agreeing = c.interior && !c.hidden ? 0u : FrameMG::kF | other;
+    // Sets within {F, other} go to the target, except in a box cell the scan saw free; a small mover's within {N, S}
+    // too (step small specialised).
+    const unsigned agreeing = (c.interior && !c.hidden ? 0u : FrameMG::kF | other) |
+                              (c.take_specialised && c.motion == CellClass::kMoving ? FrameMG::kN | other : 0u);
     float mass[kernels::kSubsets];
     kernels::loadMasses(base, c.cell, mass);
     float to_target = 0.0f;

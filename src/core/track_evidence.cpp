@@ -131,6 +131,7 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p, tracker.commonMotion()));
     c.take_n = c.motion == CellClass::kMoving && p.evidence_small_size > 0.0 &&
                t.extent_length <= p.evidence_small_size && t.extent_width <= p.evidence_small_size;
+    c.take_specialised = c.take_n && p.evidence_small_specialised;
     const std::size_t first = out.size();
     auto addReturns = [&](int measurement) {
       if (measurement < 0 || measurement >= static_cast<int>(measurements.size())) return;

@@ -559,6 +559,47 @@ TEST(MotionSteps, SmallMoverCellsAlsoGiveTheirSetsHoldingN)
   EXPECT_EQ(with.grid.decisions()[i], static_cast<std::int8_t>(CellClass::kMoving));
 }
 
+// Step "small specialised": a walker seen in the same pavement cell for several scans leaves mass on {N, S} there (the
+// counter specialises {N, S, V}); a small mover's cells with CellMotion::take_specialised also give to V the sets
+// within {N, S}, and within {F, N, S} in the cells of its returns; without the flag {N, S} keeps its mass.
+TEST(MotionSteps, SmallSpecialisedCellsAlsoGiveTheirSetsWithinNS)
+{
+  World world;
+  world.boxes.push_back({ 10.0, -0.3, 10.6, 0.3, 1.7 });
+  core::Run run(defaultProfile());
+  const GridGeometry& g = run.grid.geometry();
+  PriorWindow pavement;
+  pavement.reset(GridGeometry{ g.resolution, g.width, g.height, -0.5 * g.sizeX(), -0.5 * g.sizeY() });
+  std::fill(pavement.other.begin(), pavement.other.end(), 0.85f);
+  for (int k = 0; k < 8; ++k) run.step(world, Pose2{ 0.0, 0.0, 0.0 }, &pavement);
+  CellIndex ci;
+  ASSERT_TRUE(g.worldToCell(Point2{ 10.1, 0.1 }, ci));
+  const std::size_t i = g.index(ci);
+  const std::vector<float> before = massesOf(run.grid, i);
+  const Subset ns = FrameMG::kN | FrameMG::kS;
+  ASSERT_GT(before[ns], 0.1f) << "the counter's specialisation of the pavement's {N, S, V}";
+  const Subset fnsv = FrameMG::kF | FrameMG::kN | FrameMG::kS | FrameMG::kV;
+  for (const bool interior : { false, true })
+    for (const bool step : { true, false })
+    {
+      MapGrid grid = run.grid;
+      CellMotion c{ i, CellClass::kMoving, 0.5f };
+      c.take_n = true;
+      c.take_specialised = step;
+      c.interior = interior;  // a box cell the scan saw free (hidden stays false)
+      grid.applyTrackedMotion({ c });
+      const std::vector<float> after = massesOf(grid, i);
+      const Subset within = (interior ? 0u : FrameMG::kF | FrameMG::kS) | (step ? ns : 0u);
+      expectHalfMovedToV(before, after, [&](Subset a) {
+        return a != FrameMG::kV && (a & ~fnsv) == 0 && ((a & FrameMG::kV) || (a & ~within) == 0);
+      });
+      if (step)
+        EXPECT_NEAR(after[ns], 0.5 * before[ns], 1e-6) << "interior " << interior;
+      else
+        EXPECT_EQ(after[ns], before[ns]) << "without the flag {N, S} stays; interior " << interior;
+    }
+}
+
 // Step "movers without a map": without a prior an occupied cell holds the scan's O = {C, N, S, V}; the cells of
 // a small moving track with CellMotion::take_c also give the sets holding C (here Ω and {C, N, S, V}) to V, half of
 // each at β = 0.5; with take_n alone those keep their mass.

@@ -1030,6 +1030,22 @@ TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
   TrackerParams off = p;
   off.evidence_small_size = 0.0;
   EXPECT_EQ(flags(off, 0.6).first, 0u) << "the step off";
+  // Step small specialised flags exactly the small mover's cells.
+  auto specialised = [&](const TrackerParams& params, double width) {
+    double face = 0.0;
+    std::size_t n = 0;
+    for (const CellMotion& c : faceEvidence(params, g, 10.0, 1.0, width, face))
+    {
+      EXPECT_TRUE(!c.take_specialised || c.take_n);
+      n += c.take_specialised;
+    }
+    return n;
+  };
+  EXPECT_EQ(specialised(p, 0.6), small_cells);
+  EXPECT_EQ(specialised(p, 1.8), 0u);
+  TrackerParams not_specialised = p;
+  not_specialised.evidence_small_specialised = false;
+  EXPECT_EQ(specialised(not_specialised, 0.6), 0u);
 }
 
 namespace {

@@ -191,6 +191,10 @@ struct CellMotion
   bool take_n = false;
   /// Sets holding C move too (step movers without a map: without a prior, C is not told from N, S and V).
   bool take_c = false;
+  /// Sets within {F, N, S} (within {N, S} in an interior cell seen free) move too, for kMoving (step "small
+  /// specialised"): a walker stays in a cell for several scans, and the counter has specialised its pavement's
+  /// {N, S, V} to {N, S} before its track is moving.
+  bool take_specialised = false;
 };
 
 /// An object made of a connected region of moving or stopped cells.

@@ -128,6 +128,10 @@ struct TrackerParams
   /// of sight (away from the sensor: the rays end on its near side) and across it, so that it covers the body behind
   /// the returns.
   bool evidence_small_box = true;
+  /// Step "small specialised": a small mover's cells (step small movers) also move to V their mass on {N}, {S} and
+  /// {N, S} (and, in its returns' cells, on the sets within {F, N, S}): a walker stays in a cell for several scans, and
+  /// the counter specialises the pavement's {N, S, V} to {N, S} before its track is moving.
+  bool evidence_small_specialised = true;
   /// Step "hidden centre": a moving track seen end-on (as for step hidden length, with evidence_hidden_length > 0)
   /// reports (reportedBox(): the tracks topic, the scoring) the box of step hidden length and its centre, half a
   /// vehicle's length behind the face seen, instead of the face's. A scan that misses it (the track coasts) keeps
@@ -233,6 +237,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_common_motion_share", p.common_motion_share, { "", "share of those tracks that must agree with the median velocity" });
   get("tracker_common_motion_sigmas", p.common_motion_sigmas, { "", "a track agrees with the median when within this many σ(speed) of it" });
   get("tracker_common_motion_max_speed", p.common_motion_max_speed, { "m/s", "a faster median is traffic, not a drift: no common motion" });
+  get("tracker_evidence_small_specialised", p.evidence_small_specialised, { "", "step small specialised: a small mover's cells also move their mass on {N}, {S}, {N, S} to V (the counter's specialisation of a walker's pavement cells)" });
   get("tracker_evidence_without_map", p.evidence_without_map, { "", "step movers without a map: without a prior a moving track's return cells (and a small mover's box) also move the sets holding C or N to V" });
   get("tracker_across_face", p.across_face, { "", "step across its face: a track moving across its cluster's face (a car seen end-on) has shown its motion as the free-space check would" });
   get("tracker_across_min_hits", p.across_min_hits, { "scans", "consecutive associations a track needs before step across its face" });
