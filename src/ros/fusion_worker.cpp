@@ -216,11 +216,9 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
   }
   std::lock_guard<std::mutex> lock(mutex_);
   softener_.setPrior(prior);
-  // Softened now, for the σ in force, rather than in the next scan's callback (hundreds of ms for a large map at
-  // 0.2 m); that scan recomputes only if σ changes before it, exactly as it would have.
-  bool softened = false;
-  softener_.softened(priorSigma(), &softened);
-  if (softened) ++counters_.prior_softenings;
+  // Softened here, for the σ in force, rather than in the next scan's callback (longer than a scan period for a large
+  // map at 0.2 m); that scan recomputes only if σ changes before it.
+  softenedPrior();
 #ifdef __GLIBC__
   malloc_trim(0);  // the previous prior (possibly a huge map's) is freed: give its pages back
 #endif
@@ -228,9 +226,13 @@ void FusionWorker::onPrior(const EvidentialGrid::ConstPtr& msg)
                                         << prior->geometry.resolution << " m");
 }
 
-double FusionWorker::priorSigma() const
+const core::PriorWindow* FusionWorker::softenedPrior()
 {
-  return std::isnan(covariance_sigma_) ? grid_.params().position_sigma : covariance_sigma_;
+  const double sigma = std::isnan(covariance_sigma_) ? grid_.params().position_sigma : covariance_sigma_;
+  bool softened = false;
+  const core::PriorWindow* prior = softener_.softened(sigma, &softened);
+  if (softened) ++counters_.prior_softenings;
+  return prior;
 }
 
 void FusionWorker::onCovariance(const boost::array<double, 36>& covariance)
@@ -517,9 +519,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
                                                       "still covers it");
     }
   }
-  bool softened = false;
-  const core::PriorWindow* prior = softener_.softened(priorSigma(), &softened);
-  if (softened) ++counters_.prior_softenings;
+  const core::PriorWindow* prior = softenedPrior();
   if (!prior && !warned_no_prior_)
   {
     ROS_INFO("fusion: no prior_grid received yet: fusing with a vacuous prior");

@@ -122,8 +122,9 @@ private:
   void onPrior(const EvidentialGrid::ConstPtr& msg);
   /// A pose covariance (6 × 6 row-major): a new σ, or a counted, throttled rejection keeping the last good σ.
   void onCovariance(const boost::array<double, 36>& covariance);
-  /// σ of the prior's softening for the next scan: the last good covariance's, else position_sigma (m). Under mutex_.
-  double priorSigma() const;
+  /// The prior softened by the σ in force (the last good covariance's, else position_sigma), recomputed and counted
+  /// only when the prior or σ changed (core::PriorSoftener); nullptr without a prior. Under mutex_.
+  const core::PriorWindow* softenedPrior();
   void onReconfigure(FusionConfig& config, uint32_t level);
   /// Publishes the layers of the last update, whose prior was @p prior (nullptr: none).
   void publish(const std_msgs::Header& header, const core::PriorWindow* prior);
