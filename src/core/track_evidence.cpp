@@ -72,6 +72,14 @@ std::optional<Measurement> smallMoverBox(const Measurement& m, double size)
 
 double heading(const Track& t) { return std::atan2(t.x(3), t.x(2)); }
 
+/// Step "box margin": @p m's box grown by @p margin on each side across its axis.
+Measurement widened(Measurement m, double margin)
+{
+  m.lo_v -= margin;
+  m.hi_v += margin;
+  return m;
+}
+
 }  // namespace
 
 ObjectBox reportedBox(const Track& t, const Tracker& tracker)
@@ -158,9 +166,10 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
       if (c.take_n && p.evidence_small_box)
         addBoxInterior(smallMoverBox(m, p.evidence_small_size).value_or(m), g, c, first, out);
       else if (c.motion == CellClass::kMoving && t.speed() > 0.0)
-        addBoxInterior(hiddenLengthBox(m, heading(t), p.hidden_length ? p.evidence_hidden_length : 0.0,
-                                       p.evidence_end_width)
-                           .value_or(m),
+        addBoxInterior(widened(hiddenLengthBox(m, heading(t), p.hidden_length ? p.evidence_hidden_length : 0.0,
+                                               p.evidence_end_width)
+                                   .value_or(m),
+                               p.evidence_box_margin),
                        g, c, first, out);
       else
         addBoxInterior(m, g, c, first, out);

@@ -82,6 +82,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_small_max_speed", free_space_small_max_speed, 0.0, max_speed);
   requireInRange("tracker_evidence_hidden_length", evidence_hidden_length, 0.0, max_object_length);
   requireInRange("tracker_evidence_end_width", evidence_end_width, 0.0, max_object_width);
+  requireInRange("tracker_evidence_box_margin", evidence_box_margin, 0.0, 0.5 * max_object_width);
   requireInRange("tracker_evidence_small_size", evidence_small_size, 0.0, max_object_width);
   requireInRange("tracker_heading_box_angle", heading_box_angle, 0.0, kMaxHeadingBoxAngle);
   requireInRange("tracker_heading_box_max_length", heading_box_max_length, 0.0, max_object_length);

@@ -1129,7 +1129,72 @@ TEST(Tracker, TrackEvidenceSizeParametersAreValidatedByName)
       { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = -1.0; } },
       { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = 1e3; } },
       { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },
-      { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } } });
+      { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } },
+      { "tracker_evidence_box_margin", [](TrackerParams& p) { p.evidence_box_margin = -0.1; } },
+      { "tracker_evidence_box_margin", [](TrackerParams& p) { p.evidence_box_margin = 0.6 * p.max_object_width; } },
+      { "tracker_evidence_box_margin", [](TrackerParams& p) { p.evidence_box_margin = std::nan(""); } } });
+}
+
+TEST(Tracker, BoxMarginGivesTheMotionToTheCellsAVehiclesSidesHalfCover)
+{
+  // A van 2 m wide whose sides lie on the centres of a row of 0.5 m cells (y = 4.25 and 6.25), driving away along x
+  // at 8 m/s from a sensor at the origin. Its rear face's outermost returns are a beam step (5 cm) inside its sides.
+  const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
+  auto evidence = [&](double margin, double& face_x) {
+    TrackerParams p;
+    p.evidence_box_margin = margin;
+    Tracker tracker(p);
+    for (int k = 0; k <= 8; ++k)
+    {
+      face_x = 10.0 + 0.8 * k;
+      std::vector<Point2> points;
+      for (int j = 0; j < 20; ++j)
+        for (const double dx : { 0.0, 0.05 }) points.push_back(Point2{ face_x + dx, 4.3 + 0.1 * j });
+      const std::vector<float> xy = flatten(points);
+      tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
+    }
+    EXPECT_EQ(tracker.tracks().size(), 1u);
+    EXPECT_EQ(tracker.tracks().empty() ? TrackMotion::kUnknown : tracker.tracks()[0].motion, TrackMotion::kMoving);
+    return trackEvidence(tracker, g);
+  };
+  // The cells of the row whose centre has y = @p y, behind the face and within the hidden length.
+  auto row = [&](const std::vector<CellMotion>& cells, double face_x, double y) {
+    std::size_t n = 0;
+    for (const CellMotion& c : cells)
+    {
+      const Point2 q = g.cellCentre(g.cellOf(c.cell));
+      if (std::abs(q.y - y) < 1e-9 && q.x > face_x + 0.3 && q.x < face_x + 3.7)
+      {
+        ++n;
+        EXPECT_EQ(c.motion, CellClass::kMoving);
+        EXPECT_TRUE(c.interior);
+      }
+    }
+    return n;
+  };
+  double face = 0.0;
+  const auto with = evidence(0.1, face);
+  // Cell centres every 0.5 m in (face + 0.3, face + 3.7): 7 on each side row, as on the rows inside.
+  EXPECT_EQ(row(with, face, 4.25), 7u);
+  EXPECT_EQ(row(with, face, 6.25), 7u);
+  EXPECT_EQ(row(with, face, 5.25), 7u);
+  // Not the next rows out: the margin is less than half a cell.
+  EXPECT_EQ(row(with, face, 3.75), 0u);
+  EXPECT_EQ(row(with, face, 6.75), 0u);
+  const auto without = evidence(0.0, face);
+  EXPECT_EQ(row(without, face, 4.25), 0u);
+  EXPECT_EQ(row(without, face, 6.25), 0u);
+  EXPECT_EQ(row(without, face, 5.25), 7u);
+  // Everything the margin adds is box cells of the two side rows (without it, those rows hold only the face's
+  // outermost returns).
+  auto sides = [&](const std::vector<CellMotion>& cells) {
+    return static_cast<std::size_t>(std::count_if(cells.begin(), cells.end(), [&](const CellMotion& c) {
+      const double y = g.cellCentre(g.cellOf(c.cell)).y;
+      return c.interior && (std::abs(y - 4.25) < 1e-9 || std::abs(y - 6.25) < 1e-9);
+    }));
+  };
+  EXPECT_EQ(sides(without), 0u);
+  EXPECT_EQ(with.size(), without.size() + sides(with));
 }
 
 namespace {

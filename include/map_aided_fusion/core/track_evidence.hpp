@@ -33,8 +33,10 @@ std::vector<ObjectBox> reportedBoxes(const Tracker& tracker);
 /**
  * @brief The cells of @p geometry holding the returns of the last scan of every reported track associated in that
  *        scan (its measurement's and, with step duplicates, its fragments', Track::fragments), with the track's
- *        motion and β. Empty when evidence_weight is 0 or the tracker was given measurements
- *        without returns.
+ *        motion and β; with step track box also the cells whose centre lies in its measurement's box (interior
+ *        cells): a moving vehicle's box extended by step hidden length and grown across by evidence_box_margin on
+ *        each side (step box margin), a small mover's by step small box. Empty when evidence_weight is 0 or the
+ *        tracker was given measurements without returns.
  */
 std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry& geometry);
 

@@ -120,6 +120,10 @@ struct TrackerParams
   /// free evidence is older than the object that drove in. Cells the scan sees free stay free.
   bool evidence_box_hidden = true;
   double evidence_end_width = 1.4;  ///< m: the narrowest face that is a vehicle's end (a cyclist's is narrower)
+  /// Step "box margin": a moving track's box (of step track box; not a small mover's) grows by this on each side
+  /// across its axis (m; 0: off). A side's outermost returns lie up to a beam step inside the object's outline, so
+  /// the cells that its sides half cover have their centres just outside the cluster's box.
+  double evidence_box_margin = 0.1;
   /// Step "small movers": a moving track whose box is at most this long and wide (m; a pedestrian's) also moves to
   /// V the sets that hold N, which track evidence otherwise leaves to the prior and the counter: a pavement's prior
   /// is {N, S, V}. 0: off.
@@ -227,6 +231,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_hidden_length", p.hidden_length, { "", "step hidden length on (with tracker_evidence_hidden_length > 0)" });
   get("tracker_evidence_box_hidden", p.evidence_box_hidden, { "", "step box hidden: box cells the scan did not see free also move their free sets to V" });
   get("tracker_evidence_end_width", p.evidence_end_width, { "m", "the narrowest face that is a vehicle's end (step hidden length)" });
+  get("tracker_evidence_box_margin", p.evidence_box_margin, { "m", "step box margin: a moving track's box grows by this on each side across its axis (the cells its sides half cover); 0: off" });
   get("tracker_evidence_box", p.evidence_box, { "", "step track evidence also in the cells of the track's box that hold none of its returns" });
   get("tracker_evidence_small_size", p.evidence_small_size, { "m", "step small movers: a moving track at most this long and wide also moves the sets holding N to V; 0: off" });
   get("tracker_evidence_small_box", p.evidence_small_box, { "", "step small box: a small mover's track box is grown to tracker_evidence_small_size along and across the line of sight" });
