@@ -79,6 +79,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_small_size", free_space_small_size, 0.0, max_object_width);
   requireInRange("tracker_free_space_small_margin", free_space_small_margin, 0.0, free_space_margin);
   requireInRange("tracker_free_space_small_min_extent", free_space_small_min_extent, 0.0, max_object_width);
+  requireInRange("tracker_free_space_small_widest", free_space_small_widest, 0.0, max_object_width);
   requireInRange("tracker_free_space_small_max_speed", free_space_small_max_speed, 0.0, max_speed);
   requireInRange("tracker_evidence_hidden_length", evidence_hidden_length, 0.0, max_object_length);
   requireInRange("tracker_evidence_end_width", evidence_end_width, 0.0, max_object_width);
@@ -431,6 +432,8 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
+  t.widest_length = std::max(t.widest_length, m.length);
+  t.widest_width = std::max(t.widest_width, m.width);
   if (params_.heading_box && t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed &&
       std::max(t.extent_length, t.extent_width) <= params_.heading_box_max_length)
   {
@@ -532,9 +535,12 @@ void Tracker::decideMotion(Track& t, double stamp) const
 
 bool Tracker::smallWalker(const Track& t) const
 {
-  const double small = params_.free_space_small_size, least = params_.free_space_small_min_extent;
-  return small > 0.0 && t.extent_length <= small && t.extent_width <= small && t.extent_length >= least &&
-         t.extent_width >= least && t.speed() <= params_.free_space_small_max_speed;
+  const double small = params_.free_space_small_size, least = params_.free_space_small_min_extent,
+               widest = params_.free_space_small_widest;
+  const bool thick = (t.extent_length >= least && t.extent_width >= least) ||
+                     (widest > 0.0 && t.widest_length >= widest && t.widest_width >= widest);
+  return small > 0.0 && t.extent_length <= small && t.extent_width <= small && thick &&
+         t.speed() <= params_.free_space_small_max_speed;
 }
 
 bool Tracker::movesAcrossFace(const Track& t) const
@@ -837,8 +843,8 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     t.P.topLeftCorner<2, 2>() = z.covariance;
     t.P(2, 2) = t.P(3, 3) = v2;
     t.yaw = t.extent_yaw = z.yaw;
-    t.length = t.extent_length = z.length;
-    t.width = t.extent_width = z.width;
+    t.length = t.extent_length = t.widest_length = z.length;
+    t.width = t.extent_width = t.widest_width = z.width;
     t.hits = t.consecutive_hits = 1;
     t.first_stamp = t.last_hit = stamp;
     t.measurement = static_cast<int>(m);

@@ -573,9 +573,10 @@ namespace {
 
 /// The first scan from which the track of a small object walking along x at @p speed (from x = -2, returns at
 /// y = 5.1 … 5.4, every 0.1 m over 0.4 m along x, or a single row at y = 5.3 with @p sliver) is moving, -1 if never
-/// within 2 s. Free space is seen up to y = 5.5 only (beyond: a facade's shadow), so that every cell of the object
-/// lies next to space not seen.
-int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver)
+/// within 2 s. A sliver shows its body in scan @p body_scan only (returns at y = 5.2 … 5.4: 0.2 m wide, less than
+/// its box grows by). Free space is seen up to y = 5.5 only (beyond: a facade's shadow), so that every cell of the
+/// object lies next to space not seen.
+int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver, int body_scan = -1)
 {
   Tracker tracker(params);
   for (int k = 0; k < 20; ++k)
@@ -584,7 +585,9 @@ int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver)
     std::vector<Point2> points;
     for (int i = 0; i <= 12; ++i)
     {
-      if (sliver)
+      if (sliver && k == body_scan && i <= 4)
+        for (const double y : { 5.2, 5.3, 5.4 }) points.push_back(Point2{ x0 + 0.1 * i, y });
+      else if (sliver && k != body_scan)
         points.push_back(Point2{ x0 + 0.4 * i / 12.0, 5.3 });
       else if (i <= 4)
         for (const double y : { 5.1, 5.2, 5.3, 5.4 }) points.push_back(Point2{ x0 + 0.1 * i, y });
@@ -617,6 +620,24 @@ TEST(Tracker, SmallFreeSpaceLetsAPedestrianBesideAFacadeMove)
   TrackerParams any_extent = p;
   any_extent.free_space_small_min_extent = 0.0;
   EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), p.confirm_hits - 1) << "the sliver is moving without the least extent";
+}
+
+TEST(Tracker, WidestClusterLetsAWalkerSeenAsAColumnMove)
+{
+  // A walker seen from afar: its clusters are a single row (its box stays thinner than the least extent), but in
+  // one scan it shows a 0.4 × 0.2 m body.
+  TrackerParams p;
+  ASSERT_DOUBLE_EQ(p.free_space_small_widest, 0.15);
+  const int from = walkBesideAFacade(p, 1.4, true, 1);
+  EXPECT_GE(from, p.confirm_hits - 1) << "tentative before";
+  EXPECT_LE(from, 10) << "a walker at 1.4 m/s is moving within a second";
+  TrackerParams off = p;
+  off.free_space_small_widest = 0.0;
+  EXPECT_EQ(walkBesideAFacade(off, 1.4, true, 1), -1) << "the step off: its box alone decides, the general margin";
+  TrackerParams wider = p;
+  wider.free_space_small_widest = 0.25;
+  EXPECT_EQ(walkBesideAFacade(wider, 1.4, true, 1), -1) << "a body narrower than the widest cluster asked for";
+  EXPECT_EQ(walkBesideAFacade(p, 1.4, true), -1) << "a sliver that never shows a body";
 }
 
 namespace {
@@ -675,6 +696,9 @@ TEST(Tracker, FreeSpaceParametersAreValidatedByName)
       { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = 1e3; } },
       { "tracker_free_space_small_margin", [](TrackerParams& p) { p.free_space_small_margin = 0.6; } },
       { "tracker_free_space_small_min_extent", [](TrackerParams& p) { p.free_space_small_min_extent = -1.0; } },
+      { "tracker_free_space_small_widest", [](TrackerParams& p) { p.free_space_small_widest = -0.1; } },
+      { "tracker_free_space_small_widest", [](TrackerParams& p) { p.free_space_small_widest = 1e3; } },
+      { "tracker_free_space_small_widest", [](TrackerParams& p) { p.free_space_small_widest = std::nan(""); } },
       { "tracker_free_space_small_max_speed", [](TrackerParams& p) { p.free_space_small_max_speed = std::nan(""); } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },

@@ -90,10 +90,13 @@ struct TrackerParams
   /// free_space_margin of it, so that free space never shows where it left or came. A track at most
   /// free_space_small_size long and wide (0: off), at least free_space_small_min_extent on both axes (a sliver of a
   /// wall seen edge-on is thinner) and no faster than free_space_small_max_speed (a walk) is checked with
-  /// free_space_small_margin instead.
+  /// free_space_small_margin instead. Step "widest cluster": a track whose box stays thinner (a walker seen from
+  /// afar, where its returns are a column) also counts as thick enough once one of its clusters was at least
+  /// free_space_small_widest long and wide (Track::widest_length, widest_width; 0: off).
   double free_space_small_size = 1.0;        ///< m
   double free_space_small_margin = 0.0;      ///< m, [0, free_space_margin]
   double free_space_small_min_extent = 0.1;  ///< m
+  double free_space_small_widest = 0.15;     ///< m
   double free_space_small_max_speed = 2.0;   ///< m/s
   /// Step "heading box": a track's box keeps the axes of its first cluster, so an object that turns is seen askew in
   /// them: its box grows (a cyclist's to 1.7 × 1.6 m) and the point followed slides off the object until the gate
@@ -222,6 +225,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_free_space_small_size", p.free_space_small_size, { "m", "step small free space: a track at most this long and wide is checked with tracker_free_space_small_margin; 0: off" });
   get("tracker_free_space_small_margin", p.free_space_small_margin, { "m", "the free-space margin of a small track (step small free space)" });
   get("tracker_free_space_small_min_extent", p.free_space_small_min_extent, { "m", "… when at least this long and wide (a sliver of a wall is thinner)" });
+  get("tracker_free_space_small_widest", p.free_space_small_widest, { "m", "step widest cluster: … or when one of its clusters was at least this long and wide (a walker seen as a column from afar); 0: off" });
   get("tracker_free_space_small_max_speed", p.free_space_small_max_speed, { "m/s", "… and no faster than this (a walk)" });
   get("tracker_heading_box", p.heading_box, { "", "step heading box: a short moving track's box turns to its heading once askew" });
   get("tracker_heading_box_angle", p.heading_box_angle, { "deg", "the box turns when its axes are this far from the track's heading" });
@@ -368,6 +372,7 @@ struct Track
   Eigen::Vector4d x = Eigen::Vector4d::Zero();
   Eigen::Matrix4d P = Eigen::Matrix4d::Identity();
   double yaw = 0.0, length = 0.0, width = 0.0;  ///< of the last associated cluster
+  double widest_length = 0.0, widest_width = 0.0;  ///< m, the largest length and width of its clusters so far
   /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
   double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;
   /// Measurements of the last scan (Tracker::measurements()) that are pieces of its object besides its own: with step
