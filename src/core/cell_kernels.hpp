@@ -375,10 +375,12 @@ MAF_INLINE void conjunctiveWithScanPrior(const T (&m)[kSubsets], const T (&sp)[k
 }
 
 /**
- * m ← m ⊛ sp (sp in the sets of kScanPriorSets), the modified Yager rule; returns the conflicts.
+ * m ← m ⊛ sp (sp in the sets of kScanPriorSets), the modified Yager rule; returns the conflicts. With
+ * @p building_conflict (step building conflict) the part of ∅_FO met by sp({C}) goes to Ω instead of V.
  */
 template <bool kWall, typename T>
-MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumScanPrior], int rule = 0)
+MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumScanPrior], int rule = 0,
+                                          bool building_conflict = false)
 {
   T c[kSubsets];
   conjunctiveWithScanPrior<kWall>(m, sp, c);
@@ -393,8 +395,9 @@ MAF_INLINE CellConflicts<T> modifiedYager(T (&m)[kSubsets], const T (&sp)[kNumSc
   r.other = c[0] - r.free_occupied - r.occupied_free;
   if (rule == kRuleModifiedYager)
   {
-    c[FrameMG::kV] += r.free_occupied;
-    c[FrameMG::kOmega] += c[0] - r.free_occupied;
+    const T to_v = building_conflict ? m[FrameMG::kF] * (sp[kSpSV] + sp[kSpNSV] + sp[kSpCNSV]) : r.free_occupied;
+    c[FrameMG::kV] += to_v;
+    c[FrameMG::kOmega] += c[0] - to_v;
   }
   else if (rule == kRuleYager)
   {

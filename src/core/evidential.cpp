@@ -11,14 +11,15 @@
 namespace map_aided_fusion {
 namespace core {
 
-MassMG modifiedYager(const MassMG& m1, const MassMG& m2, ConflictMasses* conflicts)
+MassMG modifiedYager(const MassMG& m1, const MassMG& m2, ConflictMasses* conflicts, bool building_conflict)
 {
   auto r = conjunctive(m1, m2);
   const double fo = m1[FrameMG::kF] * m2.massInside(FrameMG::kO);
   const double of = m1.massInside(FrameMG::kO) * m2[FrameMG::kF];
   if (conflicts) *conflicts = ConflictMasses{ fo, of, r[0] - fo - of };
-  r[FrameMG::kV] += fo;
-  r[FrameMG::kOmega] += r[0] - fo;  // ∅_OF and the remaining conflict
+  const double to_v = building_conflict ? m1[FrameMG::kF] * (m2.massInside(FrameMG::kO) - m2[FrameMG::kC]) : fo;
+  r[FrameMG::kV] += to_v;
+  r[FrameMG::kOmega] += r[0] - to_v;  // ∅_OF, the remaining conflict (and ∅_FO met by {C}, step building conflict)
   r[0] = 0.0;
   return r;
 }

@@ -42,7 +42,7 @@ CellFusionResult fuseCell(const MassMG& map_prev, double zeta_prev, const MassSG
   r.scan_prior_total_conflict = report.total_conflict;
   const MassMG discounted = params.contextual_discounting ? contextualDiscount(map_prev, params.discount)
                                                           : discount(map_prev, params.alpha_single);
-  MassMG fused = modifiedYager(discounted, scan_prior, &r.conflicts);
+  MassMG fused = modifiedYager(discounted, scan_prior, &r.conflicts, params.building_conflict);
   if (params.rule == CombinationRule::kYager) fused = yager(discounted, scan_prior);
   if (params.rule == CombinationRule::kDempster) fused = dempster(discounted, scan_prior);
   if (!params.use_counter)
@@ -125,6 +125,7 @@ void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, co
   in.alpha_single = static_cast<float>(params.alpha_single);
   in.use_counter = params.use_counter;
   in.moving_expiry = params.moving_expiry;
+  in.building_conflict = params.building_conflict;
   for (int e = 0; e < FrameMG::kSize; ++e)
   {
     if (betp) betp->p[e].resize(in.cells);

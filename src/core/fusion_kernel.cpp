@@ -120,7 +120,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       contextualDiscount(m, weightsFor<T>(w, w8, lane));
     else
       classicalDiscount(m, in.alpha_single);
-    const auto c = modifiedYager<kWall>(m, sp, kPaper ? kRuleModifiedYager : in.rule);
+    const auto c = modifiedYager<kWall>(m, sp, kPaper ? kRuleModifiedYager : in.rule, in.building_conflict);
     if (kPaper || in.use_counter)
     {
       float* const zeta = zetaAt(base, i);

@@ -45,6 +45,7 @@ struct StepInputs
   float alpha_single;
   bool use_counter;
   bool moving_expiry;
+  bool building_conflict;  ///< FusionParams::building_conflict
   float* betp[FrameMG::kSize];  ///< BetP planes to fill, or nullptr
   std::int8_t* decision;        ///< decisions to fill (with BetP only), or nullptr
   DecisionRule decision_rule;

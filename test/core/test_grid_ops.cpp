@@ -264,6 +264,7 @@ TEST(FusionStep, MatchesScalarReferenceAndTheSequenceOfGridOps)
       ASSERT_EQ(prior.hasWall(), with_prior == 2);
       FusionParams params;
       params.moving_expiry = false;  // the paper's sequence of grid ops; the step is tested in test_motion_steps
+      params.building_conflict = false;  // the paper's ⊛; the step is tested in test_rules and below
       params.counter.mode = mode;
       params.counter.gamma_conflict = 0.3;
       params.counter.gamma_occupied = 0.4;
@@ -308,10 +309,12 @@ TEST(FusionStep, AblationVariantsMatchTheScalarReference)
     CombinationRule rule;
     bool contextual;
     bool counter;
+    bool building_conflict = false;
   };
   for (const Variant v : { Variant{ CombinationRule::kYager, true, true }, Variant{ CombinationRule::kDempster, true, true },
                            Variant{ CombinationRule::kModifiedYager, false, true },
-                           Variant{ CombinationRule::kModifiedYager, true, false } })
+                           Variant{ CombinationRule::kModifiedYager, true, false },
+                           Variant{ CombinationRule::kModifiedYager, true, true, true } })
   {
     std::mt19937 rng(9);
     const auto g = testGeometry();
@@ -324,6 +327,7 @@ TEST(FusionStep, AblationVariantsMatchTheScalarReference)
     params.contextual_discounting = v.contextual;
     params.alpha_single = 0.15;
     params.use_counter = v.counter;
+    params.building_conflict = v.building_conflict;
     fusionStep(map, scan, &prior, params);
     for (std::size_t i = 0; i < map.numCells(); ++i)
     {

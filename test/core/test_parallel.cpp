@@ -251,8 +251,10 @@ TEST(ReachableFocalSets, ClosureOfThePipelineFromTheScanAndThePrior)
 {
   FusionParams paper;
   paper.moving_expiry = false;
+  paper.building_conflict = false;
   FusionParams added = paper;
   added.moving_expiry = true;
+  added.building_conflict = true;
   const std::set<Subset> paper_sets = closure({ paper });
   const std::set<Subset> default_sets = closure({ added });
   // r(m_SG) ⊕ m_PG has nine focal sets ({F}, {C}, {S,V}, {N,S,V}, {C,N,S,V}, {F,S,V}, {F,N,S,V}, {F,C}, Ω);
@@ -262,7 +264,7 @@ TEST(ReachableFocalSets, ClosureOfThePipelineFromTheScanAndThePrior)
   EXPECT_TRUE(paper_sets.count(FrameMG::kS)) << "specialisation of {V}";
   EXPECT_TRUE(paper_sets.count(FrameMG::kOmega));
   EXPECT_FALSE(paper_sets.count(0)) << "∅ never holds mass after a step";
-  EXPECT_EQ(paper_sets, default_sets) << "moving expiry and spreading reach no new set";
+  EXPECT_EQ(paper_sets, default_sets) << "moving expiry, building conflict and spreading reach no new set";
   // Contexts add {C, N} or {S, V} whole, and every scan-prior set holding C holds N, S and V or neither V nor S:
   // C never meets V without N or S. So {C, V} and {F, C, V} are never reached, nor ∅: 29 of the 32 sets.
   EXPECT_FALSE(paper_sets.count(FrameMG::kC | FrameMG::kV));

@@ -157,6 +157,36 @@ TEST(ModifiedYager, FreeThenOccupiedGoesToMoving)
   EXPECT_EQ(r[0], 0.0);
 }
 
+TEST(ModifiedYager, BuildingConflictSendsFreeThenBuildingToOmega)
+{
+  // Seen free, now occupied evidence of which 0.5 can only be the mapped building ({C}) and 0.3 is on the road
+  // ({S, V}): ∅_FO = 0.6 · 0.8 = 0.48 either way.
+  const MassMG map{ { F, 0.6 }, { W, 0.4 } };
+  const MassMG scan_prior{ { C, 0.5 }, { S | V, 0.3 }, { W, 0.2 } };
+  ConflictMasses paper, step;
+  const auto p = modifiedYager(map, scan_prior, &paper);
+  const auto r = modifiedYager(map, scan_prior, &step, true);
+  EXPECT_NEAR(paper.free_occupied, 0.48, 1e-12);
+  EXPECT_NEAR(step.free_occupied, 0.48, 1e-12) << "the conflicts reported are the paper's";
+  EXPECT_NEAR(step.occupied_free, paper.occupied_free, 1e-15);
+  EXPECT_NEAR(step.other, paper.other, 1e-15);
+  EXPECT_NEAR(p[V], 0.48, 1e-12);
+  // The step: only the road's part, 0.6 · 0.3, is V; the building's, 0.6 · 0.5, goes to Ω.
+  EXPECT_NEAR(r[V], 0.18, 1e-12);
+  EXPECT_NEAR(r[W], p[W] + 0.30, 1e-12);
+  for (int a = 1; a < FrameMG::kNumSubsets; ++a)
+  {
+    if (a != V && a != W)
+    {
+      EXPECT_NEAR(r[a], p[a], 1e-15) << "set " << a;
+    }
+  }
+  EXPECT_TRUE(isValidMass(r));
+  // Without {C} in the evidence the step changes nothing.
+  const MassMG road{ { S | V, 0.7 }, { W, 0.3 } };
+  EXPECT_TRUE(massNear(modifiedYager(map, road, nullptr, true), modifiedYager(map, road), 1e-15));
+}
+
 TEST(ModifiedYager, OccupiedThenFreeGoesToOmega)
 {
   const MassMG map{ { S | V, 0.5 }, { W, 0.5 } };

@@ -57,6 +57,12 @@ struct FusionParams
    * vacated, often hidden behind it) or by a one-sweep flicker decays only by discounting, a trail of V.
    */
   bool moving_expiry = true;
+  /**
+   * Step "building conflict" (not in the paper): the conflict between the map's {F} and scan-and-prior evidence
+   * that can only be the mapped building, m({C}), goes to Ω instead of V (modifiedYager()). A wall whose cell was
+   * seen free (a pose error, a wall seen at a grazing angle, the free part of an outline cell) did not move.
+   */
+  bool building_conflict = true;
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const
   {

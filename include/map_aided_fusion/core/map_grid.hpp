@@ -147,6 +147,7 @@ void forEachParam(MapGridParams& p, Get&& get)
   std::string rule = toString(p.fusion.rule);
   get("combination_rule", rule, { "", "modified_yager (the paper), yager or dempster" });
   p.fusion.rule = parseCombinationRule(rule);
+  get("building_conflict", p.fusion.building_conflict, { "", "step: the conflict between {F} and evidence that can only be the mapped building ({C}) goes to Ω, not V" });
   get("moving_expiry", p.fusion.moving_expiry, { "", "step: m({V}) goes to Ω where the scan holds no occupied mass" });
   get("decision_threshold", p.decision_threshold, { "", "BetP a class needs to be a cell's decision" });
   get("min_object_cells", p.min_object_cells, { "cells", "smaller connected S or V regions are noise, not objects" });

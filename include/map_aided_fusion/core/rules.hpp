@@ -102,8 +102,14 @@ struct ConflictMasses
  * {C, N, S, V}: (m1 ⊛ m2)(V) = (m1 ∩ m2)(V) + ∅_FO and (m1 ⊛ m2)(Ω) = (m1 ∩ m2)(Ω) + ∅_OF. The paper
  * does not say where the remaining conflict (m1 ∩ m2)(∅) − ∅_FO − ∅_OF goes; as in Yager's rule it
  * goes to Ω. The result has m(∅) = 0.
+ *
+ * @p building_conflict (step "building conflict", not in the paper): the part of ∅_FO that m2 puts on {C},
+ * m1(F)·m2({C}), goes to Ω instead of V. Occupied evidence that can only be the mapped building does not show an
+ * object moving into a cell seen free: a building cannot move, so the pose or the map is off. The conflicts reported
+ * are unchanged.
  */
-MassMG modifiedYager(const MassMG& m1, const MassMG& m2, ConflictMasses* conflicts = nullptr);
+MassMG modifiedYager(const MassMG& m1, const MassMG& m2, ConflictMasses* conflicts = nullptr,
+                     bool building_conflict = false);
 
 /// The refining r_SG: {F} → {F}, {O} → {C,N,S,V}, Ω_SG → Ω_MG, ∅ → ∅ (m^{Ω_MG}(r(A)) = m^{Ω_SG}(A)).
 Subset refineSubset(Subset a_sg);
