@@ -74,8 +74,9 @@ MAF_INLINE bool sameKeptPrior(const StepInputs& in, std::size_t g, Vec8 pb, Vec8
 }
 
 /// kPaper: the paper's method (⊛, contextual discounting, counter) compiled without the ablation branches,
-/// which costs about a fifth of the time; otherwise the options are read at run time.
-template <bool kHasPrior, bool kPaper, bool kWall>
+/// which costs about a fifth of the time; otherwise the options are read at run time. kBuilding: step building
+/// conflict, compiled in with kPaper (the default profile's rule) and read at run time otherwise.
+template <bool kHasPrior, bool kPaper, bool kWall, bool kBuilding>
 MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights<float>& w, FusionStepStats& stats)
 {
   float* __restrict base = in.base;
@@ -120,7 +121,8 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
       contextualDiscount(m, weightsFor<T>(w, w8, lane));
     else
       classicalDiscount(m, in.alpha_single);
-    const auto c = modifiedYager<kWall>(m, sp, kPaper ? kRuleModifiedYager : in.rule, in.building_conflict);
+    const auto c = modifiedYager<kWall>(m, sp, kPaper ? kRuleModifiedYager : in.rule,
+                                        kPaper ? kBuilding : in.building_conflict);
     if (kPaper || in.use_counter)
     {
       float* const zeta = zetaAt(base, i);
@@ -189,12 +191,24 @@ MAF_TARGET_CLONES
 void fusionChunk(const StepInputs& in, const ContextualDiscountWeights<float>& w, bool has_prior, bool wall, bool paper,
                  FusionStepStats& out)
 {
+  // Without a prior sp({C}) is 0, so step building conflict changes nothing there.
+  const bool building = paper && has_prior && in.building_conflict;
   if (has_prior && wall)
-    paper ? fusionLoop<true, true, true>(in, w, out) : fusionLoop<true, false, true>(in, w, out);
+  {
+    if (building)
+      fusionLoop<true, true, true, true>(in, w, out);
+    else
+      paper ? fusionLoop<true, true, true, false>(in, w, out) : fusionLoop<true, false, true, false>(in, w, out);
+  }
   else if (has_prior)
-    paper ? fusionLoop<true, true, false>(in, w, out) : fusionLoop<true, false, false>(in, w, out);
+  {
+    if (building)
+      fusionLoop<true, true, false, true>(in, w, out);
+    else
+      paper ? fusionLoop<true, true, false, false>(in, w, out) : fusionLoop<true, false, false, false>(in, w, out);
+  }
   else
-    paper ? fusionLoop<false, true, false>(in, w, out) : fusionLoop<false, false, false>(in, w, out);
+    paper ? fusionLoop<false, true, false, false>(in, w, out) : fusionLoop<false, false, false, false>(in, w, out);
 }
 
 }  // namespace kernels
