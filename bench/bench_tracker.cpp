@@ -1,13 +1,17 @@
 // The tracker's cost per scan (core/tracker.hpp), one thread: association and filtering of 200 measurements against
 // 200 established tracks, the clustering of the scan's obstacle returns into those measurements, and a whole scan
-// (clustering, tracking and the free-space check on a 100 m ScanGrid).
+// (clustering, tracking and the free-space check on a 100 m ScanGrid), and the free space of one scan that the check
+// reads (core/seen_free.hpp) on the windows of the MapGrid benchmarks.
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "map_aided_fusion/core/seen_free.hpp"
 #include "map_aided_fusion/core/tracker.hpp"
+#include "window_params.hpp"
 
 using namespace map_aided_fusion::core;
 
@@ -118,8 +122,43 @@ void BM_TrackerScan(benchmark::State& state)
   state.counters["tracks"] = static_cast<double>(tracker.tracks().size());
 }
 
+/// Arg: N (cells per side, at maf_bench::windowResolution(N)). A scan seen free up to 60 m around the sensor, with
+/// 300 obstacles of 1 × 1 m to 3 × 2 m and nothing seen beyond; the default margins (0.5 m and 0 m).
+void BM_SeenFree(benchmark::State& state)
+{
+  const int n = static_cast<int>(state.range(0));
+  const double res = maf_bench::windowResolution(n);
+  ScanMassGrid scan(GridGeometry::centred(n * res, n * res, res));
+  const GridGeometry& g = scan.geometry();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> where(-60.0, 60.0), side(1.0, 3.0);
+  std::vector<std::array<double, 4>> boxes(300);
+  for (auto& b : boxes) b = { where(rng), where(rng), side(rng), side(rng) - 1.0 };
+  for (std::size_t i = 0; i < g.numCells(); ++i)
+  {
+    const Point2 c = g.cellCentre(g.cellOf(i));
+    bool obstacle = false;
+    for (const auto& b : boxes)
+      obstacle = obstacle || (std::abs(c.x - b[0]) <= 0.5 * b[2] && std::abs(c.y - b[1]) <= 0.5 * (1.0 + b[3]));
+    if (obstacle)
+      scan.setCell(i, MassSG{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } });
+    else if (std::hypot(c.x, c.y) <= 60.0)
+      scan.setCell(i, MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } });
+  }
+  const TrackerParams p;
+  std::size_t clear = 0;
+  for (auto _ : state)
+  {
+    const SeenFree seen(scan, Pose2{}, 0.0, p.free_space_margin, p.free_space_small_margin);
+    clear = seen.clearCells();
+    benchmark::DoNotOptimize(clear);
+  }
+  state.counters["clear_share"] = static_cast<double>(clear) / static_cast<double>(g.numCells());
+}
+
 }  // namespace
 
+BENCHMARK(BM_SeenFree)->Arg(200)->Arg(800)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TrackerScan)
     ->ArgNames({ "n", "free_space_check", "open_ends", "duplicates" })
     ->Args({ 200, 0, 0, 0 })

@@ -468,6 +468,51 @@ TEST(SeenFree, ClearMeansEveryCellWithinTheMarginWasSeenFree)
   EXPECT_EQ(one_cell.clearCells(), 120u * 120u - 40u * 120u - 120u - 9u);
 }
 
+TEST(SeenFree, EveryMarginAndGridShapeMatchesTheDefinitionCellByCell)
+{
+  // Random patches of free space on grids of odd shapes, margins from 0 to 12 cells (both ways of finding a row's
+  // neighbourhood, and margins wider than the grid): clear(p) at each cell centre is, by definition, every cell within
+  // the margin (square, inside the grid) having m(F) ≥ kSeenFreeMass.
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const int w = 1 + static_cast<int>(rng() % 37), h = 1 + static_cast<int>(rng() % 29);
+    const double res = 0.5;
+    ScanMassGrid scan(GridGeometry::centred(w * res, h * res, res));
+    const GridGeometry& g = scan.geometry();
+    ASSERT_EQ(g.width, w);
+    ASSERT_EQ(g.height, h);
+    // Half the grids have a few blocked cells only, so that wide margins leave clear cells and their edges.
+    const unsigned blocked_permille = trial % 2 ? static_cast<unsigned>(rng() % 400) : static_cast<unsigned>(rng() % 8);
+    std::vector<char> free(g.numCells());
+    for (std::size_t i = 0; i < g.numCells(); ++i)
+    {
+      free[i] = rng() % 1000 >= blocked_permille;
+      const float m = free[i] ? (rng() % 2 ? SeenFree::kSeenFreeMass : 0.9f) : (rng() % 2 ? 0.49f : 0.0f);
+      scan.setCell(i, MassSG{ { FrameSG::kF, m }, { FrameSG::kOmega, 1.0 - m } });
+    }
+    const int r = static_cast<int>(rng() % 13);
+    const int small = static_cast<int>(rng() % 13);
+    const SeenFree seen(scan, Pose2{ 0.0, 0.0, 0.0 }, 1.0, r * res, small * res);
+    std::size_t clear = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+      {
+        auto within = [&](int k) {
+          for (int yy = std::max(0, y - k); yy <= std::min(h - 1, y + k); ++yy)
+            for (int xx = std::max(0, x - k); xx <= std::min(w - 1, x + k); ++xx)
+              if (!free[static_cast<std::size_t>(yy) * w + xx]) return false;
+          return true;
+        };
+        const Point2 centre = g.cellCentre(CellIndex{ x, y });
+        ASSERT_EQ(seen.clear(centre), within(r)) << "cell " << x << ", " << y << " of " << w << " x " << h << ", margin " << r;
+        ASSERT_EQ(seen.clear(centre, true), within(small)) << "small margin " << small;
+        clear += within(r);
+      }
+    EXPECT_EQ(seen.clearCells(), clear);
+  }
+}
+
 TEST(Tracker, FreeSpaceCheckTellsAMoverFromAWallFragmentThatSlidesAlong)
 {
   // Vehicle frame = map frame. A 4 × 2 m car at 5 m/s along y = 5 over free road; a 1 m piece of a wall along y = 15
