@@ -1,5 +1,6 @@
 #include "map_aided_fusion/ros/conversions.hpp"
 
+#include <array>
 #include <algorithm>
 #include <cmath>
 
@@ -166,11 +167,16 @@ void GridConversions::toMessage(const core::MassGrid<Frame>& grid, const std_msg
   if (with_counter) appendSlot(grid, core::MassGrid<Frame>::kNumPlanes, msg.counter);
 }
 
+namespace {
+
+/// fromMessage()'s checks; then @p grid takes the message's geometry. Returns, per slot of @p grid (the counter
+/// last), the message's layer to copy, or nullptr for zeros.
 template <class Frame>
-void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Frame>& grid)
+std::array<const float*, core::MassGrid<Frame>::kNumPlanes + 1> sourcesOf(const EvidentialGrid& msg,
+                                                                          core::MassGrid<Frame>& grid)
 {
   checkClasses<Frame>(msg);
-  const core::GridGeometry g = fromMapMetaData(msg.info);
+  const core::GridGeometry g = GridConversions::fromMapMetaData(msg.info);
   const std::size_t n = g.numCells();
   checkSizes(msg, n);
   std::uint64_t seen = 0;
@@ -192,13 +198,57 @@ void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Fram
   }
   if (grid.geometry() != g)
     grid.reset(g);
-  for (int a = 0; a < Frame::kNumSubsets; ++a)  // each stored slot written once: copied, or zeros when absent
-    if (grid.stored(static_cast<Subset>(a)) && !(seen & (1ull << a)))
-      writeSlot(grid, grid.slot(static_cast<Subset>(a)), nullptr);
+  std::array<const float*, core::MassGrid<Frame>::kNumPlanes + 1> sources{};  // each stored slot: absent, zeros
   for (std::size_t k = 0; k < msg.focal_sets.size(); ++k)
     if (grid.stored(msg.focal_sets[k]))
-      writeSlot(grid, grid.slot(msg.focal_sets[k]), msg.masses.data() + k * n);
-  writeSlot(grid, core::MassGrid<Frame>::kNumPlanes, msg.counter.empty() ? nullptr : msg.counter.data());
+      sources[static_cast<std::size_t>(grid.slot(msg.focal_sets[k]))] = msg.masses.data() + k * n;
+  sources[core::MassGrid<Frame>::kNumPlanes] = msg.counter.empty() ? nullptr : msg.counter.data();
+  return sources;
+}
+
+}  // namespace
+
+template <class Frame>
+void GridConversions::fromMessage(const EvidentialGrid& msg, core::MassGrid<Frame>& grid)
+{
+  const auto sources = sourcesOf(msg, grid);
+  for (std::size_t s = 0; s < sources.size(); ++s) writeSlot(grid, static_cast<int>(s), sources[s]);
+}
+
+void GridConversions::scanFromMessage(const EvidentialGrid& msg, core::ScanMassGrid& grid)
+{
+  static_assert(!core::ScanMassGrid::kInterleaved, "a ScanGrid's layers are planes");
+  const auto sources = sourcesOf(msg, grid);
+  const std::size_t n = grid.numCells();
+  float* const planes = grid.planes();
+  const float *e = grid.plane(core::FrameSG::kEmpty), *f = grid.plane(core::FrameSG::kF),
+              *o = grid.plane(core::FrameSG::kO), *w = grid.plane(core::FrameSG::kOmega);
+  // Bitwise, not short-circuit, and counted: the check vectorises. A NaN fails every comparison.
+  const auto invalid = [&](std::size_t i) -> unsigned {
+    const float d = e[i] + f[i] + o[i] + w[i] - 1.0f;
+    return !((d < kScanMassTolerance) & (d > -kScanMassTolerance) & (e[i] >= 0.0f) & (f[i] >= 0.0f) &
+             (o[i] >= 0.0f) & (w[i] >= 0.0f));
+  };
+  // Chunk by chunk, so that the check reads what the copy has just written.
+  for (std::size_t i0 = 0; i0 < n; i0 += kScanCheckChunk)
+  {
+    const std::size_t i1 = std::min(n, i0 + kScanCheckChunk);
+    for (std::size_t s = 0; s < sources.size(); ++s)
+    {
+      float* const dst = planes + grid.stride() * s;
+      if (sources[s])
+        std::copy(sources[s] + i0, sources[s] + i1, dst + i0);
+      else
+        std::fill(dst + i0, dst + i1, 0.0f);
+    }
+    unsigned invalid_cells = 0;  // one pass; only then the first bad cell, to name it
+    for (std::size_t i = i0; i < i1; ++i) invalid_cells += invalid(i);
+    if (invalid_cells > 0)
+      for (std::size_t i = i0; i < i1; ++i)
+        if (invalid(i))
+          throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " +
+                                std::to_string(e[i] + f[i] + o[i] + w[i]) + ")");
+  }
 }
 
 template void GridConversions::toMessage(const core::MassGrid<FrameMG>&, const std_msgs::Header&, EvidentialGrid&,

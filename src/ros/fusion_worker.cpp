@@ -32,8 +32,6 @@ constexpr double kMaxObjectBoxHeight = 100.0;
 constexpr double kClockCheckPeriod = 0.1;
 constexpr double kWarnThrottle = 1.0;
 constexpr double kMillisecondsPerSecond = 1000.0;
-/// |Σm − 1| a scan cell may have (float rounding of the ScanGrid and its message).
-constexpr float kMassSumTolerance = 1e-3f;
 constexpr const char* kBetpTopics[core::FrameMG::kSize] = { "betp/free", "betp/building", "betp/infrastructure",
                                                              "betp/stopped", "betp/moving" };
 
@@ -393,22 +391,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   thread_local core::ScanMassGrid scan;
   try
   {
-    GridConversions::fromMessage(*msg, scan);
-    const float *e = scan.plane(core::FrameSG::kEmpty), *f = scan.plane(core::FrameSG::kF),
-                *o = scan.plane(core::FrameSG::kO), *w = scan.plane(core::FrameSG::kOmega);
-    const auto invalid = [&](std::size_t i) {
-      const float s = e[i] + f[i] + o[i] + w[i];
-      return !(std::abs(s - 1.0f) < kMassSumTolerance) || !(e[i] >= 0.0f) || !(f[i] >= 0.0f) || !(o[i] >= 0.0f) ||
-             !(w[i] >= 0.0f);
-    };
-    // One pass that vectorises tells whether a cell is bad; only then is the first one looked for, to name it.
-    bool any_invalid = false;
-    for (std::size_t i = 0; i < scan.numCells(); ++i) any_invalid |= invalid(i);
-    if (any_invalid)
-      for (std::size_t i = 0; i < scan.numCells(); ++i)
-        if (invalid(i))
-          throw ConversionError("cell " + std::to_string(i) + " is not a mass function (sum " +
-                                std::to_string(e[i] + f[i] + o[i] + w[i]) + ")");
+    GridConversions::scanFromMessage(*msg, scan);
     if (msg->obstacle_points.size() % 2 != 0)
       throw ConversionError("obstacle_points holds an odd number of coordinates");
     for (const float v : msg->obstacle_points)

@@ -1,6 +1,7 @@
 // Round trips between core grids and ROS messages, without a ROS master.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 
 #include "map_aided_fusion/core/grid_ops.hpp"
@@ -94,6 +95,79 @@ TEST(Conversions, ScanGridRoundTrip)
   GridConversions::fromMessage(msg, back);
   for (std::size_t i = 0; i < grid.numCells(); ++i)
     for (int a = 0; a < 4; ++a) ASSERT_EQ(back.at(static_cast<Subset>(a), i), grid.at(static_cast<Subset>(a), i));
+}
+
+TEST(Conversions, ScanFromMessageCopiesAsFromMessageAndNamesTheFirstCellThatIsNoMassFunction)
+{
+  // More cells than one chunk of the check, so that a bad cell in a later chunk is found there.
+  std::mt19937 rng(9);
+  const int width = 150, height = 130;
+  ASSERT_GT(static_cast<std::size_t>(width * height), GridConversions::kScanCheckChunk);
+  ScanMassGrid grid(GridGeometry{ 0.5, width, height, -2.0, -1.5 });
+  for (std::size_t i = 0; i < grid.numCells(); ++i) grid.setCell(i, maf_test::randomMass<FrameSG>(rng, 3));
+  EvidentialGrid msg;
+  GridConversions::toMessage(grid, header(), msg, PlaneSelection::kAll);
+  ScanMassGrid back, checked;
+  GridConversions::fromMessage(msg, back);
+  // A grid holding an earlier scan, and something in its counter, is overwritten.
+  checked = ScanMassGrid(grid.geometry());
+  for (std::size_t i = 0; i < checked.numCells(); ++i)
+  {
+    checked.setCell(i, MassSG{ { FrameSG::kO, 1.0 } });
+    checked.zeta(i) = 7.0f;
+  }
+  GridConversions::scanFromMessage(msg, checked);
+  for (std::size_t i = 0; i < grid.numCells(); ++i)
+  {
+    for (int a = 0; a < 4; ++a) ASSERT_EQ(checked.at(static_cast<Subset>(a), i), back.at(static_cast<Subset>(a), i));
+    ASSERT_EQ(checked.zeta(i), 0.0f);
+  }
+  EXPECT_EQ(checked.geometry(), grid.geometry());
+
+  // Each kind of bad cell, in the second chunk: the error names the first one.
+  const std::size_t n = grid.numCells(), bad = GridConversions::kScanCheckChunk + 17;
+  auto plane = [&](EvidentialGrid& m, Subset a) {
+    for (std::size_t k = 0; k < m.focal_sets.size(); ++k)
+      if (m.focal_sets[k] == a) return m.masses.data() + k * n;
+    return static_cast<float*>(nullptr);
+  };
+  auto expectRejected = [&](const std::function<void(EvidentialGrid&)>& spoil, const char* what) {
+    EvidentialGrid m = msg;
+    spoil(m);
+    try
+    {
+      GridConversions::scanFromMessage(m, checked);
+      ADD_FAILURE() << what << ": accepted";
+    }
+    catch (const ConversionError& e)
+    {
+      EXPECT_NE(std::string(e.what()).find("cell " + std::to_string(bad) + " is not a mass function"), std::string::npos)
+          << what << ": " << e.what();
+    }
+  };
+  expectRejected([&](EvidentialGrid& m) { plane(m, FrameSG::kF)[bad] += 0.01f; }, "sum 1.01");
+  expectRejected([&](EvidentialGrid& m) { plane(m, FrameSG::kOmega)[bad] = std::nanf(""); }, "NaN");
+  expectRejected(
+      [&](EvidentialGrid& m) {
+        plane(m, FrameSG::kO)[bad] -= 0.5f;
+        plane(m, FrameSG::kEmpty)[bad] -= 0.5f;
+        plane(m, FrameSG::kOmega)[bad] += 1.0f;
+      },
+      "a negative mass");
+  expectRejected(
+      [&](EvidentialGrid& m) {
+        plane(m, FrameSG::kF)[bad] += 0.5f;
+        plane(m, FrameSG::kOmega)[n - 1] = -1.0f;
+      },
+      "two bad cells");
+  // Rounding within the tolerance passes.
+  EvidentialGrid close = msg;
+  plane(close, FrameSG::kOmega)[bad] += 0.5f * GridConversions::kScanMassTolerance;
+  EXPECT_NO_THROW(GridConversions::scanFromMessage(close, checked));
+  // And the message checks of fromMessage() still come first.
+  EvidentialGrid repeated = msg;
+  repeated.focal_sets[1] = repeated.focal_sets[0];
+  EXPECT_THROW(GridConversions::scanFromMessage(repeated, checked), ConversionError);
 }
 
 TEST(Conversions, MalformedMessagesAreRejectedWithReasons)

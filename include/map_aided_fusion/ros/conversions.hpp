@@ -6,6 +6,7 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -55,6 +56,19 @@ public:
    */
   template <class Frame>
   static void fromMessage(const EvidentialGrid& msg, core::MassGrid<Frame>& grid);
+
+  /// |Σm − 1| a ScanGrid cell's masses must stay below (float sums of four masses).
+  static constexpr float kScanMassTolerance = 1e-3f;
+  /// Cells copied, then checked, at a time by scanFromMessage() (its planes' chunks stay in cache for the check).
+  static constexpr std::size_t kScanCheckChunk = 16384;
+
+  /**
+   * @brief A ScanGrid's EvidentialGrid → ScanMassGrid, as fromMessage(), each cell checked to be a mass function
+   *        (every mass ≥ 0, |Σm − 1| < kScanMassTolerance) right after it is copied.
+   * @throws ConversionError as fromMessage(), or naming the first cell that is not a mass function (@p grid then
+   *         holds the copy so far).
+   */
+  static void scanFromMessage(const EvidentialGrid& msg, core::ScanMassGrid& grid);
 
   /**
    * @brief EvidentialGrid of a PriorGrid (focal sets among B, R, T, W = {F, C}, Ω and ∅) → PriorWindow.
