@@ -1,7 +1,7 @@
 #include "map_aided_fusion/ros/conversions.hpp"
 
-#include <array>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace map_aided_fusion {

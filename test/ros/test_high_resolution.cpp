@@ -9,14 +9,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <malloc.h>
-#include <sys/resource.h>
 #include <cmath>
 #include <iostream>
 #include <map>
 #include <mutex>
 #include <string>
 #include <vector>
+
+#include <malloc.h>
+#include <sys/resource.h>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -36,6 +37,8 @@ constexpr int kHeapBlockBytes = 32 * 1024 * 1024;
 /// … and keeps this much freed memory at the heap's top instead of handing it back.
 constexpr int kKeptFreeBytes = 512 * 1024 * 1024;
 
+constexpr double kStartX = -120.0, kLaneY = -1.5;
+
 /// Minor page faults of this process so far.
 long minorFaults()
 {
@@ -43,7 +46,6 @@ long minorFaults()
   getrusage(RUSAGE_SELF, &u);
   return u.ru_minflt;
 }
-constexpr double kStartX = -120.0, kLaneY = -1.5;
 
 double median(std::vector<double> v)
 {
@@ -184,18 +186,17 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
 
   std::lock_guard<std::mutex> lock(mutex);
   std::vector<double> l, steady;  // every cloud's; those past the first tenth, as the diagnostics are sampled
+  std::cout << "latency in order:";
   for (std::size_t k = 0; k < sent.size(); ++k)
     if (auto it = latency_ms.find(sent[k]); it != latency_ms.end())
     {
+      std::cout << " " << std::lround(it->second);
       l.push_back(it->second);
       if (k >= sent.size() / 10) steady.push_back(it->second);
     }
+  std::cout << "\n";
   std::sort(l.begin(), l.end());
   std::sort(steady.begin(), steady.end());
-  std::cout << "latency in order:";
-  for (std::size_t k = 0; k < sent.size(); ++k)
-    if (auto it = latency_ms.find(sent[k]); it != latency_ms.end()) std::cout << " " << std::lround(it->second);
-  std::cout << "\n";
   const std::size_t dropped = sent.size() - l.size();
   std::cout << "high resolution (800 x 800 cells at 0.2 m, " << per_cloud << " points per cloud, " << clouds
             << " clouds at 10 Hz): latency cloud stamp -> decision (ms): median "
@@ -235,7 +236,7 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   RecordProperty("latency_steady_p90_ms", steady.empty() ? -1 : static_cast<int>(std::lround(steady[steady.size() * 9 / 10])));
   RecordProperty("latency_max_ms", l.empty() ? -1 : static_cast<int>(std::lround(l.back())));
   RecordProperty("clouds_without_decision", static_cast<int>(dropped));
-  // The stand-in lidar's own page faults per cloud (serialising a 4 MB cloud into fresh pages costs ~15 ms here).
+  // The stand-in lidar's own page faults per cloud (a 4 MB cloud serialised into fresh pages delays it by ~15 ms).
   std::cout << "page faults of the test process per cloud: " << faults_per_cloud << "\n";
   RecordProperty("test_page_faults_per_cloud", static_cast<int>(std::lround(faults_per_cloud)));
   EXPECT_GE(per_cloud, 120000u);
