@@ -793,6 +793,17 @@ void MapGrid::recentre(Point2 p)
   shift(dx, dy);
 }
 
+bool MapGrid::follow(Point2 p)
+{
+  if (scans_ == 0) return false;
+  const GridGeometry& g = grid_.geometry();
+  const double cx = g.origin_x + 0.5 * g.sizeX(), cy = g.origin_y + 0.5 * g.sizeY();
+  if (std::max(std::abs(p.x - cx), std::abs(p.y - cy)) <= params_.recentre_distance) return false;
+  const double x0 = g.origin_x, y0 = g.origin_y;
+  recentre(p);
+  return grid_.geometry().origin_x != x0 || grid_.geometry().origin_y != y0;
+}
+
 FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, double stamp, const PriorWindow* prior,
                                 StageTimes* times, const ObstaclePoints* obstacles)
 {
@@ -806,12 +817,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
     grid_.setOrigin(o.x, o.y);
   }
   else
-  {
-    const GridGeometry& g = grid_.geometry();
-    const double cx = g.origin_x + 0.5 * g.sizeX(), cy = g.origin_y + 0.5 * g.sizeY();
-    if (std::max(std::abs(pose.x - cx), std::abs(pose.y - cy)) > params_.recentre_distance)
-      recentre(Point2{ pose.x, pose.y });
-  }
+    follow(Point2{ pose.x, pose.y });
   t.shift = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();

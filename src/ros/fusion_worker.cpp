@@ -109,6 +109,8 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
       [this](const EvidentialGrid::ConstPtr& msg, tf2_ros::FilterFailureReason reason) { onScanDropped(msg, reason); });
   prior_sub_ = nh_.subscribe("prior_grid", 1, &FusionWorker::onPrior, this);
   scan_sub_ = nh_.subscribe("scan_grid", queue, &FusionWorker::onScanIn, this);
+  if (node_params_.shift_ahead)
+    started_sub_ = nh_.subscribe("scan_grid/started", 1, &FusionWorker::onScanStarted, this);
   if (node_params_.pose_covariance_topic.empty())
     ROS_INFO_STREAM("fusion: no pose_covariance_topic: the prior is softened by position_sigma = "
                     << grid_.params().position_sigma << " m");
@@ -378,9 +380,36 @@ void FusionWorker::checkClock()
 
 void FusionWorker::LatencyWindows::setSpan(double span)
 {
-  for (core::SlidingSamples* w : { &cloud_to_callback, &cloud_to_decision, &conversion, &shift, &project_scan,
-                                   &prior_window, &fusion, &tracking, &outputs, &skipped })
+  for (core::SlidingSamples* w : { &cloud_to_callback, &cloud_to_decision, &conversion, &shift, &shift_ahead,
+                                   &project_scan, &prior_window, &fusion, &tracking, &outputs, &skipped })
     w->setSpan(span);
+}
+
+void FusionWorker::onScanStarted(const std_msgs::Header::ConstPtr& header)
+{
+  const double stamp = header->stamp.toSec();
+  if (stamp <= 0.0 || !tf_buffer_.canTransform(node_params_.map_frame, header->frame_id, header->stamp)) return;
+  core::Point2 p;
+  try
+  {
+    const geometry_msgs::Transform t =
+        tf_buffer_.lookupTransform(node_params_.map_frame, header->frame_id, header->stamp).transform;
+    p = core::Point2{ t.translation.x, t.translation.y };
+  }
+  catch (const tf2::TransformException&)
+  {
+    return;
+  }
+  if (!std::isfinite(p.x) || !std::isfinite(p.y)) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  const ros::Time now = ros::Time::now();
+  const bool ahead_of_clock = !now.isZero() && stamp - now.toSec() > node_params_.future_tolerance;
+  if (pending_params_ || ahead_of_clock || stamp_guard_.check(stamp, !now.isZero()) != core::StampVerdict::kFuse)
+    return;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (grid_.follow(p)) ++counters_.shifts_ahead;
+  const std::chrono::duration<double> took = std::chrono::steady_clock::now() - t0;
+  latency_.shift_ahead.add(core::steadySeconds(), kMillisecondsPerSecond * took.count());
 }
 
 void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
@@ -689,6 +718,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   quantiles("latency cloud to decision", latency_.cloud_to_decision);
   quantiles("stage conversion", latency_.conversion);
   quantiles("stage shift", latency_.shift);
+  quantiles("stage shift ahead", latency_.shift_ahead);
   quantiles("stage project scan", latency_.project_scan);
   quantiles("stage prior window", latency_.prior_window);
   quantiles("stage fusion step", latency_.fusion);
@@ -714,6 +744,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("covariances rejected", counters_.covariance_rejected);
   status.add("sigma clamped (over the bound)", counters_.sigma_clamped);
   status.add("prior softenings", counters_.prior_softenings);
+  status.add("window shifts ahead (shift_ahead)", counters_.shifts_ahead);
   status.add("tracker", tracker_ ? "on" : "off");
   if (tracker_)
   {

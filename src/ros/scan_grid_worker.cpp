@@ -6,6 +6,7 @@
 
 #include <boost/make_shared.hpp>
 #include <nav_msgs/OccupancyGrid.h>
+#include <std_msgs/Header.h>
 
 #include "map_aided_fusion/EvidentialGrid.h"
 #include "map_aided_fusion/core/parameters.hpp"
@@ -127,6 +128,7 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
 
   grid_pub_ = nh_.advertise<EvidentialGrid>("scan_grid", 1);
   occupancy_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("scan_grid/occupancy", 1);
+  started_pub_ = nh_.advertise<std_msgs::Header>("scan_grid/started", 1);
   cloud_sub_ = nh_.subscribe("points", static_cast<std::uint32_t>(params_.input_queue_size), &ScanGridWorker::onCloud,
                              this, ros::TransportHints().tcpNoDelay());
   active_ = true;
@@ -319,6 +321,13 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
       ROS_WARN("scan_grid: a cloud on %s is not deskewed (%s): %s. Further clouds skipped for this reason are only "
                "counted (see diagnostics).",
                cloud_sub_.getTopic().c_str(), deskew.status.c_str(), deskew.detail.c_str());
+  }
+  if (started_pub_.getNumSubscribers() > 0)
+  {
+    auto started = boost::make_shared<std_msgs::Header>();
+    started->stamp = cloud->header.stamp;
+    started->frame_id = params_.base_frame;
+    started_pub_.publish(started);
   }
   if (!builder_.build(view, grid_, &last_stats_))
   {

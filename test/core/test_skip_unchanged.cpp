@@ -65,12 +65,14 @@ struct Drive
   std::vector<Snapshot> after;      ///< after each scan
   std::vector<double> skipped;      ///< MapGrid::skippedShare() after each scan
   std::vector<bool> recentred;      ///< whether the window moved in each scan
+  std::vector<bool> moved_ahead;    ///< whether MapGrid::follow() moved it before the scan's update (ahead)
 };
 
 /// A drive whose scans see a disc around the vehicle (free, with a few occupied cells that move), the vehicle
 /// driving, stopping, then driving again (so that the window recentres), tracked motion written on unseen cells and
-/// one write through mutableMasses().
-Drive drive(MapGridParams params, bool skip, PriorKind prior_kind)
+/// one write through mutableMasses(). With @p ahead, the window is moved by MapGrid::follow() before each update, as
+/// the fusion node's shift_ahead does.
+Drive drive(MapGridParams params, bool skip, PriorKind prior_kind, bool ahead = false)
 {
   params.size_x = params.size_y = kWindow;
   params.resolution = kResolution;
@@ -103,8 +105,14 @@ Drive drive(MapGridParams params, bool skip, PriorKind prior_kind)
     }
     const bool with_prior = prior_kind == PriorKind::kAlways || (prior_kind == PriorKind::kFromScan20 && step >= 20);
     const double origin_x = grid.geometry().origin_x;
+    d.moved_ahead.push_back(ahead && grid.follow(Point2{ pose.x, pose.y }));
+    const double before_update = grid.geometry().origin_x;
     const FusionStepStats s = grid.update(scan, pose, 0.1 * step, with_prior ? &prior : nullptr);
     d.recentred.push_back(step > 0 && grid.geometry().origin_x != origin_x);
+    if (ahead && step > 0)  // the first update places the window
+    {
+      EXPECT_EQ(grid.geometry().origin_x, before_update) << "scan " << step << ": update() moved the window again";
+    }
     if (step == 30)
     {
       // Tracked motion on cells far from the vehicle (stable by now), then a write through mutableMasses().
@@ -158,6 +166,27 @@ TEST(SkipUnchanged, PaperProfileGivesTheSameBytesAfterEveryScan)
 {
   expectSameDrives(paperProfile().map_grid, PriorKind::kAlways, "paper, prior");
   expectSameDrives(paperProfile().map_grid, PriorKind::kNone, "paper, no prior");
+}
+
+TEST(SkipUnchanged, AWindowMovedAheadGivesTheSameBytesAfterEveryScan)
+{
+  for (const auto& [params, what] : { std::pair{ defaultProfile().map_grid, "default" },
+                                      std::pair{ paperProfile().map_grid, "paper" } })
+    for (const bool skip : { true, false })
+    {
+      const Drive there = drive(params, skip, PriorKind::kAlways);
+      const Drive ahead = drive(params, skip, PriorKind::kAlways, true);
+      int moved = 0;
+      for (std::size_t k = 0; k < there.after.size(); ++k)
+      {
+        EXPECT_TRUE(ahead.after[k] == there.after[k]) << what << ", skip " << skip << ": scan " << k << " differs";
+        EXPECT_EQ(ahead.moved_ahead[k], there.recentred[k]) << what << ": scan " << k;
+        EXPECT_EQ(ahead.skipped[k], there.skipped[k]) << what << ": scan " << k;
+        moved += ahead.moved_ahead[k];
+      }
+      EXPECT_GE(moved, 3) << what << ": the drive recentres";
+      EXPECT_FALSE(ahead.moved_ahead[0]) << what << ": nothing to follow before the first scan";
+    }
 }
 
 TEST(SkipUnchanged, NothingIsSkippedWithRatesPerSecond)

@@ -56,12 +56,15 @@ double median(std::vector<double> v)
 
 /// The share of cells the fusion's step skipped, windowed median.
 constexpr const char* kSkippedKey = "cells skipped (skip_unchanged) median [share]";
+/// The window shifts the fusion made on `scan_grid/started`, before their scans (shift_ahead), since it started.
+constexpr const char* kShiftsAheadKey = "window shifts ahead (shift_ahead)";
 
 /// The windowed latencies the nodelets' diagnostics report (median and p90 over their last window), by key.
 const char* const kWindowedKeys[] = { "latency cloud to grid published", "processing time",
                                       "latency cloud to fusion callback", "stage conversion", "stage shift",
-                                      "stage project scan", "stage prior window", "stage fusion step",
-                                      "stage tracking", "stage outputs", "latency cloud to decision" };
+                                      "stage shift ahead", "stage project scan", "stage prior window",
+                                      "stage fusion step", "stage tracking", "stage outputs",
+                                      "latency cloud to decision" };
 
 /// The diagnostics' stage times, one sample per diagnostics message while clouds flow.
 struct StageSamples
@@ -69,6 +72,7 @@ struct StageSamples
   std::vector<double> scan_grid_ms, update_ms, callback_ms;
   std::map<std::string, double> windowed;  ///< the last windowed median/p90 of each key (ms), while clouds flow
   double skipped_share = -1.0;              ///< the last kSkippedKey
+  double shifts_ahead = -1.0;               ///< the last kShiftsAheadKey
 
   void add(const diagnostic_msgs::DiagnosticArray& m)
   {
@@ -94,6 +98,7 @@ struct StageSamples
             for (const char* unit : { " [ms]", " (ms)" })
               if (auto it = v.find(std::string(key) + q + unit); it != v.end()) windowed[std::string(key) + q] = it->second;
       if (auto it = v.find(kSkippedKey); it != v.end()) skipped_share = it->second;
+      if (auto it = v.find(kShiftsAheadKey); it != v.end()) shifts_ahead = it->second;
       if (endsWith(": ScanGrid") && v.count("processing time mean (ms)") && v["processing time mean (ms)"] > 0.0)
         scan_grid_ms.push_back(v["processing time mean (ms)"]);
       if (endsWith(": fusion") && v.count("time total with outputs [ms]") && v["time total with outputs [ms]"] > 0.0)
@@ -113,6 +118,8 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   double speed = 10.0;
   pnh.param("clouds", clouds, clouds);
   pnh.param("speed", speed, speed);
+  bool shift_ahead = true;  // the fusion's parameter, set by the launch file
+  pnh.param("shift_ahead", shift_ahead, shift_ahead);
   std::mutex mutex;
   std::map<std::int64_t, double> latency_ms;  // by cloud stamp
   unsigned width = 0, height = 0;
@@ -239,6 +246,12 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   // The stand-in lidar's own page faults per cloud (a 4 MB cloud serialised into fresh pages delays it by ~15 ms).
   std::cout << "page faults of the test process per cloud: " << faults_per_cloud << "\n";
   RecordProperty("test_page_faults_per_cloud", static_cast<int>(std::lround(faults_per_cloud)));
+  // At 10 m/s the window recentres every few metres: with shift_ahead, on the announcements, before the scans.
+  RecordProperty("window_shifts_ahead", static_cast<int>(std::lround(stages.shifts_ahead)));
+  if (shift_ahead)
+    EXPECT_GT(stages.shifts_ahead, 0.0) << "the fusion moved the window on no scan_grid/started";
+  else
+    EXPECT_EQ(stages.shifts_ahead, 0.0) << "shift_ahead is off";
   EXPECT_GE(per_cloud, 120000u);
   EXPECT_LE(per_cloud, 140000u);
   EXPECT_EQ(width, 800u);

@@ -332,6 +332,15 @@ public:
   /// Centres the window on @p p by a whole-cell shift (no-op when already centred).
   void recentre(Point2 p);
 
+  /**
+   * @brief Moves the window as update() would for a scan taken at @p p: recentre() when @p p is farther than
+   *        recentre_distance from the window's centre, nothing before the first scan. An update() at the same @p p
+   *        then leaves the window where it is, so that the shift can be made while that scan is still being built
+   *        (the fusion node's shift_ahead): the grid after the update is the same, byte for byte.
+   * @return whether the window moved
+   */
+  bool follow(Point2 p);
+
   const MapMassGrid& masses() const { return grid_; }
   /// The masses to change in place: the next update() computes every cell again (MapGridParams::skip_unchanged).
   /// (A separate name, so that reading masses() never costs the next update its skipped cells.)

@@ -15,6 +15,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
+#include <std_msgs/Header.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
@@ -47,6 +48,7 @@ struct FusionCounters
   std::size_t covariance_rejected = 0;  ///< pose covariances refused (NaN, negative variance, asymmetric)
   std::size_t sigma_clamped = 0;        ///< covariances whose σ exceeded core::kMaxPositionSigma (clamped)
   std::size_t prior_softenings = 0;     ///< times the prior was softened anew (new prior or σ changed)
+  std::size_t shifts_ahead = 0;         ///< window shifts made on `scan_grid/started`, before their scan (shift_ahead)
 };
 
 /// The fusion node's own parameters besides the MapGrid's (config/fusion.yaml).
@@ -58,6 +60,9 @@ struct FusionNodeParams
   double future_tolerance = 10.0;       ///< s a scan may be stamped ahead of a lagging clock, [0, 3600]
   bool publish_free_cells = false;      ///< also draw free cells in `cells`
   double object_box_height = 1.5;       ///< m, height of the object boxes, (0, 100]
+  /// Move the window when `scan_grid/started` announces a scan, while its ScanGrid is built, rather than when the
+  /// ScanGrid arrives: the same shift (core::MapGrid::follow()), off the cloud-to-decision path.
+  bool shift_ahead = true;
   /// Topic of the vehicle's pose covariance ("" : none, the MapGrid's position_sigma is used).
   std::string pose_covariance_topic;
   /// Its type: "pose" (geometry_msgs/PoseWithCovarianceStamped) or "odometry" (nav_msgs/Odometry).
@@ -80,6 +85,8 @@ void forEachParam(FusionNodeParams& p, Get&& get)
   get("future_tolerance", p.future_tolerance, { "s", "a scan may be stamped this far ahead of a lagging clock" });
   get("publish_free_cells", p.publish_free_cells, { "", "also draw free cells in the cells markers" });
   get("object_box_height", p.object_box_height, { "m", "height of the object boxes" });
+  get("shift_ahead", p.shift_ahead,
+      { "", "move the window when scan_grid/started announces a scan, while its ScanGrid is built" });
   get("pose_covariance_topic", p.pose_covariance_topic, { "", "topic of the vehicle pose covariance (\"\": position_sigma is used)" });
   get("pose_covariance_type", p.pose_covariance_type, { "", "pose (PoseWithCovarianceStamped) or odometry (nav_msgs/Odometry)" });
   core::forEachParam(p.time, get);
@@ -87,8 +94,8 @@ void forEachParam(FusionNodeParams& p, Get&& get)
 }
 
 /**
- * Topics: in `scan_grid`, `prior_grid`, and the pose covariance when configured; out `map_grid`, `betp/<class>`,
- * `decision`, `navigable`, `cells`, `objects`.
+ * Topics: in `scan_grid`, `scan_grid/started` (shift_ahead), `prior_grid`, and the pose covariance when configured;
+ * out `map_grid`, `betp/<class>`, `decision`, `navigable`, `cells`, `objects`.
  *
  * Time: scans are fused in stamp order. A scan stamped 0, further ahead of the clock than
  * future_tolerance, with the stamp of the last fused one, or older than it (released late after a tf gap) is
@@ -112,6 +119,9 @@ public:
 private:
   void onScanIn(const EvidentialGrid::ConstPtr& msg);
   void onScan(const EvidentialGrid::ConstPtr& msg);
+  /// shift_ahead: a ScanGrid stamped @p header is being built; the window moves now as its update would move it,
+  /// when the pose at that stamp is already in tf and the scan would be fused (a newer stamp, no pending parameters).
+  void onScanStarted(const std_msgs::Header::ConstPtr& header);
   /// Clock watch on a wall timer: a backward jump resets once; transforms ahead of the clock are cleared.
   void checkClock();
   /// Resets the grid and the time state after a genuine jump; caller holds mutex_.
@@ -168,6 +178,7 @@ private:
   {
     core::SlidingSamples cloud_to_callback, cloud_to_decision, conversion, shift, project_scan, prior_window, fusion,
         tracking, outputs;
+    core::SlidingSamples shift_ahead;  ///< the shifts made on `scan_grid/started`, before the scan's callback
     core::SlidingSamples skipped;  ///< share of the window's cells the step skipped (MapGridParams::skip_unchanged)
     void setSpan(double span);
   };
@@ -178,7 +189,7 @@ private:
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   std::unique_ptr<tf2_ros::MessageFilter<EvidentialGrid>> scan_filter_;
-  ros::Subscriber scan_sub_, prior_sub_, covariance_sub_;
+  ros::Subscriber scan_sub_, started_sub_, prior_sub_, covariance_sub_;
   ros::Publisher map_grid_pub_, decision_pub_, navigable_pub_, cells_pub_, objects_pub_;
   ros::Publisher tracks_pub_, tracks_markers_pub_;
   ros::Publisher betp_pub_[core::FrameMG::kSize];

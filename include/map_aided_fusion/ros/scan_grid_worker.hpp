@@ -172,6 +172,7 @@ private:
   ros::Subscriber cloud_sub_;
   ros::Publisher grid_pub_;
   ros::Publisher occupancy_pub_;
+  ros::Publisher started_pub_;  ///< `scan_grid/started`: the header of each ScanGrid as its build starts
   ros::WallTimer diagnostic_timer_, clock_timer_;
 };
 
