@@ -539,6 +539,57 @@ void shiftPlane(T* p, const GridGeometry& g, int dx, int dy, T fill)
   }
 }
 
+/// shiftPlane() of the cells of the blocks @p stable flags after the move (MapMassGrid::kBlockCells cells each, all
+/// of whose sources lie inside the window), run by run of flagged blocks: the values a skipped block keeps. The other
+/// cells are left as they are, for the next step to write.
+template <typename T>
+void shiftStableBlocks(T* p, const GridGeometry& g, int dx, int dy, const std::uint8_t* stable)
+{
+  constexpr std::size_t kB = MapMassGrid::kBlockCells;
+  const std::size_t w = static_cast<std::size_t>(g.width), blocks = w / kB;
+  const bool forward = dy > 0 || (dy == 0 && dx > 0);
+  const bool backward_in_row = dy == 0 && dx < 0;  // the row reads itself: right to left
+  const auto move = [&](T* row, std::size_t sy, std::size_t b, std::size_t e) {
+    const T* const src = p + sy * w + static_cast<std::ptrdiff_t>(b * kB) + dx;
+    std::memmove(row + b * kB, src, (e - b) * kB * sizeof(T));
+  };
+  for (int k = 0; k < g.height; ++k)
+  {
+    const int y = forward ? k : g.height - 1 - k;
+    const std::uint8_t* const f = stable + static_cast<std::size_t>(y) * blocks;
+    T* const row = p + static_cast<std::size_t>(y) * w;
+    const auto sy = static_cast<std::size_t>(y + dy);  // inside wherever a block is flagged
+    if (!backward_in_row)
+    {
+      for (std::size_t b = 0; b < blocks;)
+      {
+        if (!f[b])
+        {
+          ++b;
+          continue;
+        }
+        std::size_t e = b + 1;
+        while (e < blocks && f[e]) ++e;
+        move(row, sy, b, e);
+        b = e;
+      }
+      continue;
+    }
+    for (std::size_t e = blocks; e > 0;)
+    {
+      if (!f[e - 1])
+      {
+        --e;
+        continue;
+      }
+      std::size_t b = e - 1;
+      while (b > 0 && f[b - 1]) --b;
+      move(row, sy, b, e);
+      e = b;
+    }
+  }
+}
+
 /// The value a vacated cell takes in slot @p s (ζ: MapMassGrid::kNumPlanes): vacuous, ζ = 0.
 float vacatedValue(int s) { return s == MapMassGrid::slot(FrameMG::kOmega) ? 1.0f : 0.0f; }
 
@@ -672,15 +723,17 @@ void MapGrid::shiftStable(int dx, int dy)
       stable_[static_cast<std::size_t>(y) * blocks_per_row + bx] = stable;
     }
   }
-  // What a skipped block keeps moves with it: its kept prior, BetP and decision (vacated cells are computed next).
+  // What a skipped block keeps moves with it: its kept prior, BetP and decision. The next step computes every other
+  // cell (those of blocks no longer stable, vacated cells) and writes its BetP and decision.
   constexpr int kPlanes = 4 + FrameMG::kSize;
+  const std::uint8_t* const flags = stable_.data();
   parallel_->forChunks(kPlanes + 1, [&](std::size_t k) {
     if (k < 4)
-      shiftPlane(kept_[k].data(), g, dx, dy, 0.0f);
+      shiftStableBlocks(kept_[k].data(), g, dx, dy, flags);
     else if (k < kPlanes)
-      shiftPlane(betp_.p[k - 4].data(), g, dx, dy, 1.0f / FrameMG::kSize);
+      shiftStableBlocks(betp_.p[k - 4].data(), g, dx, dy, flags);
     else
-      shiftPlane(decision_.data(), g, dx, dy, static_cast<std::int8_t>(CellClass::kUnknown));
+      shiftStableBlocks(decision_.data(), g, dx, dy, flags);
   });
 }
 

@@ -324,8 +324,9 @@ public:
   /**
    * @brief Moves the window by whole cells: the cell at (x, y) moves to (x − dx, y − dy) and the origin by
    *        (dx, dy) cells. Masses and ζ are moved bit-exactly; with skip_unchanged, the flags of the skipped blocks
-   *        move too, with BetP and the decisions, so that the next update still skips what stayed unchanged
-   *        (vacated cells are vacuous and computed by it).
+   *        move too, with their BetP, decisions and kept prior, so that the next update still skips what stayed
+   *        unchanged. That update computes every other cell and writes its BetP and decision (vacated cells are
+   *        vacuous): until then, pignistic() and decisions() hold only for the blocks that stay skipped.
    */
   void shift(int dx, int dy);
 
