@@ -292,16 +292,14 @@ void FusionWorker::onScanIn(const EvidentialGrid::ConstPtr& msg)
                                                   << counters_.zero_stamp << " so far");
       return;
     }
-    const ros::Time now = ros::Time::now();
-    const double ahead = now.isZero() ? 0.0 : stamp - now.toSec();
-    const bool after_jump = core::steadySeconds() - last_jump_wall_ < core::kAfterJumpWatch;
-    if (ahead > node_params_.future_tolerance || (after_jump && ahead > node_params_.time.time_jump_threshold))
+    const AheadOfClock ahead = aheadOfClock(stamp);
+    if (ahead.too_far)
     {
       countLost(counters_.future_stamp);
-      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << ", " << ahead
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << ", " << ahead.seconds
                                                                      << " s ahead of the clock (future_tolerance "
                                                                      << node_params_.future_tolerance << " s"
-                                                                     << (after_jump ? ", after a backward clock jump" : "")
+                                                                     << (ahead.after_jump ? ", after a backward clock jump" : "")
                                                                      << "), dropped; " << counters_.future_stamp
                                                                      << " so far");
       return;
@@ -385,6 +383,17 @@ void FusionWorker::LatencyWindows::setSpan(double span)
     w->setSpan(span);
 }
 
+FusionWorker::AheadOfClock FusionWorker::aheadOfClock(double stamp) const
+{
+  const ros::Time now = ros::Time::now();
+  AheadOfClock a;
+  a.seconds = now.isZero() ? 0.0 : stamp - now.toSec();
+  a.after_jump = core::steadySeconds() - last_jump_wall_ < core::kAfterJumpWatch;
+  a.too_far = a.seconds > node_params_.future_tolerance ||
+              (a.after_jump && a.seconds > node_params_.time.time_jump_threshold);
+  return a;
+}
+
 void FusionWorker::onScanStarted(const std_msgs::Header::ConstPtr& header)
 {
   const double stamp = header->stamp.toSec();
@@ -402,9 +411,8 @@ void FusionWorker::onScanStarted(const std_msgs::Header::ConstPtr& header)
   }
   if (!std::isfinite(p.x) || !std::isfinite(p.y)) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  const ros::Time now = ros::Time::now();
-  const bool ahead_of_clock = !now.isZero() && stamp - now.toSec() > node_params_.future_tolerance;
-  if (pending_params_ || ahead_of_clock || stamp_guard_.check(stamp, !now.isZero()) != core::StampVerdict::kFuse)
+  if (pending_params_ || aheadOfClock(stamp).too_far ||
+      stamp_guard_.check(stamp, !ros::Time::now().isZero()) != core::StampVerdict::kFuse)
     return;
   const auto t0 = std::chrono::steady_clock::now();
   if (grid_.follow(p)) ++counters_.shifts_ahead;

@@ -122,6 +122,15 @@ private:
   /// shift_ahead: a ScanGrid stamped @p header is being built; the window moves now as its update would move it,
   /// when the pose at that stamp is already in tf and the scan would be fused (a newer stamp, no pending parameters).
   void onScanStarted(const std_msgs::Header::ConstPtr& header);
+  /// How far a stamp is ahead of ROS time, and whether a scan so stamped is dropped for it (further than
+  /// future_tolerance, or than time_jump_threshold soon after a backward jump). Under mutex_.
+  struct AheadOfClock
+  {
+    double seconds = 0.0;  ///< 0 before the clock's first value
+    bool after_jump = false;
+    bool too_far = false;
+  };
+  AheadOfClock aheadOfClock(double stamp) const;
   /// Clock watch on a wall timer: a backward jump resets once; transforms ahead of the clock are cleared.
   void checkClock();
   /// Resets the grid and the time state after a genuine jump; caller holds mutex_.
