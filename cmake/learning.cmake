@@ -1,6 +1,6 @@
 # Learning: generated drives with a held-out split and the optuna tuner (learning/, Python, Debian's python3-optuna),
 # installed beside the package's executables (`rosrun map_aided_fusion tune`), and their pytest suites.
-catkin_install_python(PROGRAMS learning/tune learning/make_drives DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+catkin_install_python(PROGRAMS learning/tune learning/make_drives learning/held_out DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 install(DIRECTORY learning/maf_learning DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION}
   PATTERN "__pycache__" EXCLUDE)
 install(FILES learning/drives.yaml learning/search_space.yaml DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/learning)

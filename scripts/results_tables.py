@@ -4,7 +4,8 @@
     results_tables.py OUT [--doc DOC_DIR --readme README.md]
 
 Writes OUT/results.md (every table) and OUT/results_summary.md (the README's table: default against paper on the
-simulator, KITTI 00 and KITTI tracking). With --doc and --readme, and only when every dataset was evaluated, also
+simulator, KITTI 00, KITTI tracking and the held-out drives, OUT/held_out from learning/held_out). With --doc and
+--readme, and only when every dataset was evaluated, also
 DOC_DIR/results.md, the README's block between the `results:begin` and `results:end` markers and (--figure) the
 picture under DOC_DIR/images/: the documentation then shows what this run measured, never a typed figure.
 """
@@ -20,13 +21,20 @@ END = "<!-- results:end -->"
 SIMULATOR = "default scenario (simulator, 600 scans, town map)"
 KITTI00 = "KITTI 00 (real, 10 sweeps, 3 labelled, no map)"
 TRACKING = "KITTI tracking 0000 (real, 154 sweeps, 5 movers, no map)"
+HELD_OUT = "Held-out drives (simulator, `learning/drives.yaml`)"
 
 
-def load(path):
+def read_json(path):
     if not os.path.exists(path):
         return None
     with open(path) as f:
-        return json.load(f)["variants"]
+        return json.load(f)
+
+
+def load(path):
+    """The variants of an `evaluate` metrics.json, or None when it is absent."""
+    data = read_json(path)
+    return data["variants"] if data else None
 
 
 def num(v, digits=3):
@@ -89,7 +97,21 @@ def table(variants, columns, names=None):
     return head + rule + rows
 
 
-def summary(sim, kitti, tracking):
+def held_out_table(held):
+    """Each held-out drive, then the drives pooled, for each profile, in the simulator's columns."""
+    presets = {d["name"]: d["preset"] for d in held["drives"]}
+    lines = ["| drive | profile | " + " | ".join(c for c, _ in SIM_COLUMNS) + " |",
+             "| --- | --- | " + " | ".join("---:" for _ in SIM_COLUMNS) + " |"]
+    for profile, v in held["variants"].items():
+        rows = [(f"`{n}` ({presets.get(n, '?')})", m) for n, m in v["drives"].items()]
+        rows.append((f"pooled ({len(v['drives'])} drives)", v["pooled"]))
+        lines += [f"| {name} | {profile} | " + " | ".join(f(m) for _, f in SIM_COLUMNS) + " |" for name, m in rows]
+    return ("The held-out split of `learning/drives.yaml` (never used for learning), written by `learning/held_out`: "
+            "each drive, then the drives pooled (confusion matrices, movers and CLEAR-MOT counts summed over the "
+            "drives, not averaged; `learning/maf_learning/objective.py`).\n\n" + "\n".join(lines) + "\n")
+
+
+def summary(sim, kitti, tracking, held=None):
     """One table: each dataset's key figures for the default and the paper profiles."""
     lines = ["| data | figure | default | paper |", "| --- | --- | ---: | ---: |"]
 
@@ -98,8 +120,13 @@ def summary(sim, kitti, tracking):
             lines.append(f"| {data} | {title} | {f(variants['default'])} | {f(variants['paper'])} |")
 
     cols = dict(SIM_COLUMNS)
-    for title in ("IoU F", "IoU C", "V precision", "V recall", "movers V ≤ 1 s", "V trail (cells/scan)", "MOTA"):
+    for title in ("IoU F", "IoU C", "V precision", "V recall", "movers V ≤ 1 s", "V trail (cells/scan)", "MOTA",
+                  "velocity RMSE (m/s)"):
         add("simulator", sim, title, cols[title])
+    if held:
+        pooled = {profile: v["pooled"] for profile, v in held["variants"].items()}
+        for title in ("V precision", "V recall", "movers V ≤ 1 s", "MOTA", "velocity RMSE (m/s)"):
+            add("held-out drives, pooled", pooled, title, cols[title])
     cols = dict(KITTI_COLUMNS)
     for title in ("false V / labelled sweep", "motorcyclist V share from its 3rd sweep"):
         add("KITTI 00", kitti, title, cols[title])
@@ -119,6 +146,7 @@ def main():
     sim = load(os.path.join(a.out, "metrics.json"))
     kitti = load(os.path.join(a.out, "kitti", "metrics.json"))
     tracking = load(os.path.join(a.out, "kitti_tracking", "metrics.json"))
+    held = read_json(os.path.join(a.out, "held_out", "metrics.json"))  # learning/held_out's
     if sim is None:
         sys.exit(f"results_tables.py: {a.out}/metrics.json is missing (run scripts/demo)")
 
@@ -128,8 +156,10 @@ def main():
              "replaying the bag; `default_without_<step>` is the default with one added step off (doc/steps.md), "
              "`dempster`, `yager`, `single_rate`, `no_counter` are ablations of the paper. "
              "doc/evaluation.md defines every figure.\n\n",
-             "## Summary\n\n", summary(sim, kitti, tracking),
+             "## Summary\n\n", summary(sim, kitti, tracking, held),
              f"\n## {SIMULATOR}\n\n", table(sim, SIM_COLUMNS)]
+    if held:
+        parts += [f"\n## {HELD_OUT}\n\n", held_out_table(held)]
     if kitti:
         parts += [f"\n## {KITTI00}\n\n", table(kitti, KITTI_COLUMNS)]
     if tracking:
@@ -150,14 +180,15 @@ def main():
     with open(os.path.join(a.out, "results.md"), "w") as f:
         f.write(text)
     with open(os.path.join(a.out, "results_summary.md"), "w") as f:
-        f.write(summary(sim, kitti, tracking))
+        f.write(summary(sim, kitti, tracking, held))
     print(f"wrote {a.out}/results.md")
 
     if a.doc and a.readme:
-        missing = [name for name, v in (("KITTI 00", kitti), ("KITTI tracking", tracking)) if v is None]
+        missing = [name for name, v in (("KITTI 00", kitti), ("KITTI tracking", tracking), ("held-out drives", held))
+                   if v is None]
         if missing:
-            print(f"results_tables.py: {', '.join(missing)} not evaluated (../shared/data absent): "
-                  "doc/results.md and the README are left as they are")
+            print(f"results_tables.py: {', '.join(missing)} not evaluated (the real ones need ../shared/data, the "
+                  "held-out drives learning/held_out): doc/results.md and the README are left as they are")
             return
         with open(os.path.join(a.doc, "results.md"), "w") as f:
             f.write(text)
@@ -166,7 +197,7 @@ def main():
         i, j = readme.find(BEGIN), readme.find(END)
         if i < 0 or j < i:
             sys.exit(f"results_tables.py: {a.readme} has no results markers")
-        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, kitti, tracking) + readme[j:]
+        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, kitti, tracking, held) + readme[j:]
         with open(a.readme, "w") as f:
             f.write(readme)
         print(f"wrote {a.doc}/results.md and the README's results table")

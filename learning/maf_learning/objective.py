@@ -51,6 +51,7 @@ def pool(metrics_list):
     out["trail"] = trail / scans if scans else 0.0
     out["stopped_moving"] = stopped / scans if scans else 0.0
     out["movers"] = pool_movers(metrics_list)
+    out["tracks"] = pool_tracks(metrics_list)
     return out
 
 
@@ -78,6 +79,25 @@ def pool_movers(metrics_list):
             "median_delay_s": median,
             "mean_v_share": sum(o["v_share"] for o in movers) / len(movers) if movers else 0.0,
             "s_share": sum(o["s_share"] * o["occupied_cells"] for o in movers) / cells if cells else 0.0}
+
+
+def pool_tracks(metrics_list):
+    """The tracks' CLEAR-MOT counts pooled over drives (doc/evaluation.md, "Tracks: CLEAR-MOT"): MOTA = 1 - (misses +
+    false positives + id switches) / objects over all their frames, and the velocity RMSE over all matched pairs
+    (each drive's RMSE weighted by its pairs). Drives without tracks (the paper's method) are left out; None when no
+    drive has any."""
+    keys = ("objects", "misses", "false_positives", "id_switches", "velocity_pairs")
+    with_tracks = [m for m in metrics_list if all(f"tracks.{k}" in m for k in keys)]
+    if not with_tracks:
+        return {"drives": 0, "mota": None, "velocity_rmse_mps": None}
+    total = {k: sum(int(m[f"tracks.{k}"]) for m in with_tracks) for k in keys}
+    errors = total["misses"] + total["false_positives"] + total["id_switches"]
+    pairs = total["velocity_pairs"]
+    squared = sum((m.get("tracks.velocity_rmse_mps") or 0.0) ** 2 * int(m["tracks.velocity_pairs"])
+                  for m in with_tracks)
+    return {"drives": len(with_tracks), **total,
+            "mota": 1.0 - errors / total["objects"] if total["objects"] else None,
+            "velocity_rmse_mps": (squared / pairs) ** 0.5 if pairs else None}
 
 
 def score(pooled, reference=None):

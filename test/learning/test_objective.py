@@ -26,3 +26,25 @@ def test_median_is_never_when_most_movers_are_never_detected_and_empty_is_neutra
     assert p["median_delay_s"] is None
     empty = obj.pool_movers([{}])
     assert empty["seen"] == 0 and empty["median_delay_s"] is None and empty["s_share"] == 0.0
+
+
+def tracks(objects, misses, false_positives, id_switches, pairs, rmse):
+    return {"tracks.objects": objects, "tracks.misses": misses, "tracks.false_positives": false_positives,
+            "tracks.id_switches": id_switches, "tracks.velocity_pairs": pairs, "tracks.velocity_rmse_mps": rmse}
+
+
+def test_tracks_pool_sums_the_clear_mot_counts_and_weighs_each_rmse_by_its_pairs():
+    paper = {"moving.precision": 0.2}  # the paper's method has no tracks: left out, not counted as zero
+    p = obj.pool_tracks([tracks(100, 10, 5, 1, 80, 0.5), paper, tracks(50, 0, 4, 0, 20, 1.0)])
+    assert p["drives"] == 2 and p["objects"] == 150 and p["velocity_pairs"] == 100
+    assert p["mota"] == pytest.approx(1.0 - (10 + 5 + 1 + 0 + 4 + 0) / 150)
+    assert p["velocity_rmse_mps"] == pytest.approx(((0.25 * 80 + 1.0 * 20) / 100) ** 0.5)
+    one = obj.pool_tracks([tracks(674, 74, 75, 5, 600, 0.919059)])
+    assert one["mota"] == pytest.approx(0.771513, abs=1e-6), "one drive pools to its own MOTA"
+    assert one["velocity_rmse_mps"] == pytest.approx(0.919059)
+
+
+def test_tracks_pool_without_tracks_says_none():
+    p = obj.pool_tracks([{"moving.precision": 0.2}, {}])
+    assert p["drives"] == 0 and p["mota"] is None and p["velocity_rmse_mps"] is None
+    assert obj.pool_tracks([tracks(0, 0, 0, 0, 0, None)])["velocity_rmse_mps"] is None

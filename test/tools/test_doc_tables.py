@@ -23,6 +23,16 @@ def sim(iou_f, movers):
             "movers.all.detected_within_1s": movers, "movers.all.seen": 11, "moving.trail_cells_per_scan": 0.5}
 
 
+def write_held_out(path, default_movers):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    drive = dict(sim(0.75, default_movers), **{"tracks.mota": 0.8, "tracks.velocity_rmse_mps": 0.25})
+    pooled = dict(drive, **{"movers.all.seen": 11})
+    with open(path, "w") as f:
+        json.dump({"drives": [{"name": "town_101", "preset": "vlp32"}],
+                   "variants": {"default": {"pooled": pooled, "drives": {"town_101": drive}},
+                                "paper": {"pooled": sim(0.5, 2), "drives": {"town_101": sim(0.5, 2)}}}}, f)
+
+
 def fake_readme(tmp):
     path = os.path.join(tmp, "README.md")
     with open(path, "w") as f:
@@ -42,6 +52,7 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     write_metrics(str(out / "kitti_tracking" / "metrics.json"),
                   {"default": {"movers.all.detected_within_1s": 3, "movers.all.seen": 5, "tracks.mota": 0.853},
                    "paper": {"movers.all.detected_within_1s": 1, "movers.all.seen": 5}})
+    write_held_out(str(out / "held_out" / "metrics.json"), 9)
     (tmp_path / "doc").mkdir()
     readme = fake_readme(str(tmp_path))
     figure = tmp_path / "figure2.png"
@@ -53,10 +64,26 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     assert "| KITTI 00 | false V / labelled sweep | 2.5 | 140.0 |" in text
     assert "| KITTI tracking | movers V ≤ 1 s | 3/5 | 1/5 |" in text
     assert "| KITTI tracking | MOTA | 0.85 | – |" in text, "the paper has no tracks"
+    assert "| held-out drives, pooled | movers V ≤ 1 s | 9/11 | 2/11 |" in text
+    assert "| held-out drives, pooled | velocity RMSE (m/s) | 0.25 | – |" in text
     assert "old table" not in text and text.endswith("after\n")
     doc = open(tmp_path / "doc" / "results.md").read()
     assert "## KITTI 00" in doc and "| default | 0.875 |" in doc
+    assert "| `town_101` (vlp32) | default | 0.750 |" in doc and "| pooled (1 drives) | paper | 0.500 |" in doc
     assert (tmp_path / "doc" / "images" / "figure2.png").read_bytes() == b"png"
+
+
+def test_docs_are_left_alone_without_the_held_out_drives(tmp_path):
+    out = tmp_path / "out"
+    write_metrics(str(out / "metrics.json"), {"default": sim(0.875, 4), "paper": sim(0.5, 7)})
+    write_metrics(str(out / "kitti" / "metrics.json"), {"default": {}, "paper": {}})
+    write_metrics(str(out / "kitti_tracking" / "metrics.json"), {"default": {}, "paper": {}})
+    (tmp_path / "doc").mkdir()
+    readme = fake_readme(str(tmp_path))
+    r = run(str(out), "--doc", str(tmp_path / "doc"), "--readme", readme)
+    assert "held-out drives not evaluated" in r.stdout
+    assert "old table" in open(readme).read()
+    assert "Held-out" not in open(out / "results.md").read()
 
 
 def test_docs_are_left_alone_without_the_real_datasets(tmp_path):
