@@ -24,6 +24,18 @@ double distanceToFootprint(const MotObject& o, core::Point2 p)
   return std::hypot(u, v);
 }
 
+double sumOfSquares(const std::vector<double>& v)
+{
+  double s = 0.0;
+  for (double e : v) s += e * e;
+  return s;
+}
+
+double rms(const std::vector<double>& v)
+{
+  return v.empty() ? std::nan("") : std::sqrt(sumOfSquares(v) / static_cast<double>(v.size()));
+}
+
 double median(std::vector<double> v)
 {
   if (v.empty()) return std::nan("");
@@ -130,7 +142,10 @@ void ClearMot::addFrame(const std::vector<MotObject>& objects, const std::vector
     h.ever_tracked = true;
     now[o.id] = hyp.id;
     if (o.has_velocity && hyp.has_velocity)
+    {
       velocity_errors_.push_back(distance(o.velocity, hyp.velocity));
+      h.velocity_errors.push_back(velocity_errors_.back());
+    }
   }
   // An object absent from this frame is not tracked in it: a later pair after the gap resumes it.
   for (auto& [id, h] : history_)
@@ -159,18 +174,13 @@ double ClearMot::mota() const
 
 double ClearMot::motp() const { return matches_ ? distance_sum_ / static_cast<double>(matches_) : std::nan(""); }
 
-double ClearMot::velocityRmse() const
-{
-  if (velocity_errors_.empty()) return std::nan("");
-  double s = 0.0;
-  for (double e : velocity_errors_) s += e * e;
-  return std::sqrt(s / static_cast<double>(velocity_errors_.size()));
-}
+double ClearMot::velocityRmse() const { return rms(velocity_errors_); }
 
 double ClearMot::velocityMedian() const { return median(velocity_errors_); }
 
 std::vector<MotObjectRecord> ClearMot::records() const
 {
+  const double all = sumOfSquares(velocity_errors_);
   std::vector<MotObjectRecord> out;
   for (const auto& [id, h] : history_)
   {
@@ -183,6 +193,10 @@ std::vector<MotObjectRecord> ClearMot::records() const
     std::uint64_t best = 0;
     for (const auto& [hyp, n] : h.paired_with) best = std::max(best, n);
     r.identity_share = h.frames ? static_cast<double>(best) / static_cast<double>(h.frames) : 0.0;
+    r.velocity_pairs = h.velocity_errors.size();
+    r.velocity_rmse = rms(h.velocity_errors);
+    r.velocity_median = median(h.velocity_errors);
+    r.velocity_error_share = all > 0.0 ? sumOfSquares(h.velocity_errors) / all : 0.0;
     out.push_back(r);
   }
   return out;

@@ -26,6 +26,26 @@ std::string number(double v)
   return buf;
 }
 
+/// Per judged object of the tracks' CLEAR-MOT (ClearMot::records()), a JSON array.
+std::string trackObjectsJson(const ClearMot& tracks)
+{
+  std::ostringstream out;
+  out << "[";
+  bool first = true;
+  for (const MotObjectRecord& r : tracks.records())
+  {
+    out << (first ? "" : ", ") << "{\"id\": " << r.id << ", \"frames\": " << r.frames
+        << ", \"tracked_frames\": " << r.tracked_frames << ", \"identity_share\": " << number(r.identity_share)
+        << ", \"id_switches\": " << r.id_switches << ", \"fragmentations\": " << r.fragmentations
+        << ", \"velocity_pairs\": " << r.velocity_pairs << ", \"velocity_rmse_mps\": " << number(r.velocity_rmse)
+        << ", \"velocity_median_mps\": " << number(r.velocity_median)
+        << ", \"velocity_error_share\": " << number(r.velocity_error_share) << "}";
+    first = false;
+  }
+  out << "]";
+  return out.str();
+}
+
 std::string escape(const std::string& s)
 {
   std::string out;
@@ -287,6 +307,7 @@ std::string toJson(const std::vector<VariantScores>& variants, const std::map<st
     }
     out << "]}";
     if (!v.movers.stamps().empty()) out << ",\n      \"movers_objects\": " << moverObjectsJson(v.movers);
+    if (v.tracks.frames() > 0) out << ",\n      \"tracks_objects\": " << trackObjectsJson(v.tracks);
     out << "\n    }";
   }
   out << "\n  }\n}\n";
@@ -321,7 +342,9 @@ std::string moversJson(const std::vector<VariantScores>& variants, const std::ma
     for (const auto& [k, x] : v.movers.summary()) out << ",\n      \"" << k << "\": " << number(x);
     if (v.tracks.frames() > 0)
       for (const auto& [k, x] : v.tracks.summary()) out << ",\n      \"tracks." << k << "\": " << number(x);
-    out << ",\n      \"movers_objects\": " << moverObjectsJson(v.movers) << "\n    }";
+    out << ",\n      \"movers_objects\": " << moverObjectsJson(v.movers);
+    if (v.tracks.frames() > 0) out << ",\n      \"tracks_objects\": " << trackObjectsJson(v.tracks);
+    out << "\n    }";
   }
   out << "\n  }\n}\n";
   return out.str();
@@ -380,11 +403,14 @@ std::string tracksMarkdown(const std::vector<VariantScores>& variants)
   for (const auto& v : variants)
   {
     if (v.tracks.frames() == 0 || (v.name != "default" && v.name.rfind("live", 0) != 0)) continue;
-    out << "\nPer mover, tracks of `" << v.name << "`:\n\n| id | sweeps moving | tracked as moving | identity share | "
-           "id switches | fragmentations |\n| ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    out << "\nPer mover, tracks of `" << v.name << "` (velocity errors over its pairs with a velocity; share: of the "
+           "squared velocity error of all movers):\n\n| id | sweeps moving | tracked as moving | identity share | "
+           "id switches | fragmentations | velocity pairs | velocity RMSE (m/s) | velocity median (m/s) | share of "
+           "the squared velocity error |\n| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     for (const MotObjectRecord& r : v.tracks.records())
       out << "| " << r.id << " | " << r.frames << " | " << r.tracked_frames << " | " << f(r.identity_share, 2) << " | "
-          << r.id_switches << " | " << r.fragmentations << " |\n";
+          << r.id_switches << " | " << r.fragmentations << " | " << r.velocity_pairs << " | " << f(r.velocity_rmse, 2)
+          << " | " << f(r.velocity_median, 2) << " | " << f(r.velocity_error_share, 2) << " |\n";
   }
   return out.str();
 }

@@ -157,6 +157,22 @@ TEST(ClearMot, VelocityErrorsOverPairsWithBothVelocities)
   EXPECT_EQ(mot.velocityPairs(), 3u);
   EXPECT_NEAR(mot.velocityRmse(), std::sqrt((0.09 + 0.16 + 1.44) / 3.0), 1e-12);
   EXPECT_NEAR(mot.velocityMedian(), 0.4, 1e-12);
+  // Per object: o1 has errors 0.3 and 1.2, o2 0.4, o3 no velocity; shares of 0.09 + 0.16 + 1.44 = 1.69.
+  const auto r = mot.records();
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[0].velocity_pairs, 2u);
+  EXPECT_NEAR(r[0].velocity_rmse, std::sqrt((0.09 + 1.44) / 2.0), 1e-12);
+  EXPECT_NEAR(r[0].velocity_median, 0.75, 1e-12);
+  EXPECT_NEAR(r[0].velocity_error_share, 1.53 / 1.69, 1e-12);
+  EXPECT_EQ(r[1].velocity_pairs, 1u);
+  EXPECT_NEAR(r[1].velocity_rmse, 0.4, 1e-12);
+  EXPECT_NEAR(r[1].velocity_error_share, 0.16 / 1.69, 1e-12);
+  EXPECT_EQ(r[2].velocity_pairs, 0u);
+  EXPECT_TRUE(std::isnan(r[2].velocity_rmse) && std::isnan(r[2].velocity_median));
+  EXPECT_DOUBLE_EQ(r[2].velocity_error_share, 0.0);
+  double shares = 0.0;
+  for (const MotObjectRecord& x : r) shares += x.velocity_error_share;
+  EXPECT_NEAR(shares, 1.0, 1e-12) << "the objects' shares make the whole squared error";
 }
 
 TEST(ClearMot, EmptyAndInvalid)

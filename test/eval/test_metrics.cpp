@@ -132,6 +132,24 @@ TEST(Reports, JsonAndMarkdownCarryTheNamedMetrics)
   const auto json = toJson({ v }, { { "scenario", "test" } });
   EXPECT_NE(json.find("\"moving.recall\": 0.75"), std::string::npos) << json;
   EXPECT_NE(json.find("\"scenario\": \"test\""), std::string::npos);
+  EXPECT_EQ(json.find("tracks_objects"), std::string::npos) << "no tracks scored";
+  // With tracks: each judged object's record, its velocity error (|3.5 − 5|) and its share of the squared error.
+  MotObject o;
+  o.id = 7;
+  o.has_velocity = true;
+  o.velocity = core::Point2{ 5.0, 0.0 };
+  MotHypothesis h;
+  h.id = 3;
+  h.has_velocity = true;
+  h.velocity = core::Point2{ 3.5, 0.0 };
+  v.tracks.addFrame({ o }, { h });
+  const auto with_tracks = toJson({ v }, {});
+  EXPECT_NE(with_tracks.find("\"tracks_objects\": [{\"id\": 7, \"frames\": 1, \"tracked_frames\": 1, "
+                             "\"identity_share\": 1, \"id_switches\": 0, \"fragmentations\": 0, "
+                             "\"velocity_pairs\": 1, \"velocity_rmse_mps\": 1.5, \"velocity_median_mps\": 1.5, "
+                             "\"velocity_error_share\": 1}]"),
+            std::string::npos)
+      << with_tracks;
   v.confusion.add(0, 4, 6);  // free cells decided V
   v.confusion.add(1, 3, 1);  // a facade cell decided S
   v.confusion.add(1, 1, 3);

@@ -23,6 +23,11 @@ def sim(iou_f, movers):
             "movers.all.detected_within_1s": movers, "movers.all.seen": 11, "moving.trail_cells_per_scan": 0.5}
 
 
+def track(mover, rmse, share):
+    return {"id": mover, "frames": 10, "tracked_frames": 9, "identity_share": 1.0, "velocity_pairs": 9,
+            "velocity_rmse_mps": rmse, "velocity_median_mps": 1.5, "velocity_error_share": share}
+
+
 def write_held_out(path, default_movers):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     drive = dict(sim(0.75, default_movers), **{"tracks.mota": 0.8, "tracks.velocity_rmse_mps": 0.25})
@@ -46,7 +51,9 @@ def run(*args):
 
 def test_summary_reads_each_profile_from_its_variant(tmp_path):
     out = tmp_path / "out"
-    write_metrics(str(out / "metrics.json"), {"default": sim(0.875, 4), "paper": sim(0.5, 7)})
+    tracked = dict(sim(0.875, 4), movers_objects={"objects": [{"id": 5, "kind": "bus"}, {"id": 9, "kind": "car"}]},
+                   tracks_objects=[track(9, 0.25, 0.2), track(5, 2.0, 0.8)])
+    write_metrics(str(out / "metrics.json"), {"default": tracked, "paper": sim(0.5, 7)})
     write_metrics(str(out / "kitti" / "metrics.json"),
                   {"default": {"false_v_per_labelled_sweep": 2.5}, "paper": {"false_v_per_labelled_sweep": 140}})
     write_metrics(str(out / "kitti_tracking" / "metrics.json"),
@@ -70,6 +77,9 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     doc = open(tmp_path / "doc" / "results.md").read()
     assert "## KITTI 00" in doc and "| default | 0.875 |" in doc
     assert "| `town_101` (vlp32) | default | 0.750 |" in doc and "| pooled (1 drives) | paper | 0.500 |" in doc
+    # The movers' velocity errors, the largest share of the squared error first; none for KITTI without tracks.
+    assert "| 5 | bus | 10 | 9 | 1.00 | 9 | 2.00 | 1.50 | 0.80 |\n| 9 | car |" in doc
+    assert doc.count("Per mover, the tracks of") == 1
     assert (tmp_path / "doc" / "images" / "figure2.png").read_bytes() == b"png"
 
 

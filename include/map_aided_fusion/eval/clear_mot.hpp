@@ -17,7 +17,8 @@
  *  - fragmentations: per object, how often its tracked state goes from tracked to untracked and is resumed later;
  *  - velocity error: |v_hypothesis − v_object| over the pairs where both velocities are known (RMSE and median);
  *  - per object, the identity share: of the frames it is present and judged, the share in which it is paired with
- *    its most frequent hypothesis id.
+ *    its most frequent hypothesis id; and its own velocity errors (pairs, RMSE, median) with their share of the
+ *    squared velocity error of all objects (which objects make the RMSE).
  */
 #pragma once
 
@@ -62,6 +63,11 @@ struct MotObjectRecord
   std::uint64_t fragmentations = 0;
   std::uint64_t id_switches = 0;
   double identity_share = 0.0;       ///< frames paired with its most frequent hypothesis id / frames
+  std::uint64_t velocity_pairs = 0;  ///< its pairs with both velocities known
+  double velocity_rmse = 0.0;        ///< m/s over those pairs; NaN without any
+  double velocity_median = 0.0;      ///< m/s; NaN without any
+  /// Its squared velocity errors / those of every object (0 when no object has any): its share of RMSE².
+  double velocity_error_share = 0.0;
 };
 
 /// Accumulates CLEAR-MOT counts frame after frame.
@@ -107,6 +113,7 @@ private:
     std::uint64_t pending_gaps = 0;     ///< tracked → untracked transitions not yet resumed
     std::uint64_t fragmentations = 0;
     std::map<std::uint32_t, std::uint64_t> paired_with;
+    std::vector<double> velocity_errors;  ///< m/s, its pairs with both velocities known
   };
   double threshold_;
   std::uint64_t frames_ = 0, objects_ = 0, matches_ = 0, misses_ = 0, false_positives_ = 0, id_switches_ = 0;

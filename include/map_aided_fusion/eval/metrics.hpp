@@ -137,12 +137,14 @@ std::string tracksMarkdown(const std::vector<VariantScores>& variants);
 /// with movers scored, also MoverScorer::summary()'s keys; with tracks, ClearMot::summary()'s as "tracks.*".
 std::map<std::string, double> flatten(const VariantScores& v);
 
-/// metrics.json: {"variants": {name: {"description": …, metric: value…, "movers_objects": {…}}}, "meta": {…}};
-/// "movers_objects" (moverObjectsJson()) only when movers were scored.
+/// metrics.json: {"variants": {name: {"description": …, metric: value…, "movers_objects": {…}, "tracks_objects":
+/// […]}}, "meta": {…}}; "movers_objects" (moverObjectsJson()) only when movers were scored, "tracks_objects" (each
+/// judged object's ClearMot record: identity share, velocity pairs, RMSE, median and share of the squared velocity
+/// error) only with tracks.
 std::string toJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta);
 
 /// metrics.json of labelled boxes (no class grid): {"meta": {…}, "variants": {name: {"description": …, "scans": …,
-/// MoverScorer::summary()'s keys…, "movers_objects": {…}}}}.
+/// MoverScorer::summary()'s keys…, "movers_objects": {…}, "tracks_objects": […]}}} (as toJson()).
 std::string moversJson(const std::vector<VariantScores>& variants, const std::map<std::string, std::string>& meta);
 
 /// A Markdown table, one row per variant.
