@@ -387,7 +387,8 @@ FusionWorker::AheadOfClock FusionWorker::aheadOfClock(double stamp) const
 {
   const ros::Time now = ros::Time::now();
   AheadOfClock a;
-  a.seconds = now.isZero() ? 0.0 : stamp - now.toSec();
+  a.clock_started = !now.isZero();
+  a.seconds = a.clock_started ? stamp - now.toSec() : 0.0;
   a.after_jump = core::steadySeconds() - last_jump_wall_ < core::kAfterJumpWatch;
   a.too_far = a.seconds > node_params_.future_tolerance ||
               (a.after_jump && a.seconds > node_params_.time.time_jump_threshold);
@@ -411,8 +412,8 @@ void FusionWorker::onScanStarted(const std_msgs::Header::ConstPtr& header)
   }
   if (!std::isfinite(p.x) || !std::isfinite(p.y)) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (pending_params_ || aheadOfClock(stamp).too_far ||
-      stamp_guard_.check(stamp, !ros::Time::now().isZero()) != core::StampVerdict::kFuse)
+  const AheadOfClock ahead = aheadOfClock(stamp);
+  if (pending_params_ || ahead.too_far || stamp_guard_.check(stamp, ahead.clock_started) != core::StampVerdict::kFuse)
     return;
   const auto t0 = std::chrono::steady_clock::now();
   if (grid_.follow(p)) ++counters_.shifts_ahead;

@@ -127,6 +127,7 @@ private:
   struct AheadOfClock
   {
     double seconds = 0.0;  ///< 0 before the clock's first value
+    bool clock_started = false;  ///< ROS time has a value
     bool after_jump = false;
     bool too_far = false;
   };
