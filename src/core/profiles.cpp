@@ -104,6 +104,12 @@ const std::vector<AddedStep>& addedSteps()
     { "across_face", "a track seen in every one of its last scans that moves across its cluster's face has shown its motion as free space would",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.across_face; },
       [](Profile& p) { p.tracker.across_face = false; } },
+    { "background_split", "the returns of a cluster too long or wide that are not on static background are clustered again: a pedestrian beside a wall",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.background_split; },
+      [](Profile& p) { p.tracker.background_split = false; } },
+    { "walked", "a small walker seen in each of its last scans that moved far enough has shown its motion as free space would",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.walked; },
+      [](Profile& p) { p.tracker.walked = false; } },
   };
   return steps;
 }

@@ -95,6 +95,11 @@ void TrackerParams::validate() const
   requireInRange("tracker_across_min_length", across_min_length, 0.0, max_object_length);
   requireInRange("tracker_across_max_width_share", across_max_width_share, kMinShare, 1.0);
   requireInRange("tracker_across_sigmas", across_sigmas, 0.0, 10.0);
+  requirePositive("tracker_background_split_size", background_split_size);
+  requireInRange("tracker_background_split_size", background_split_size, 0.0, max_object_width);
+  requireInRange("tracker_walk_min_hits", walk_min_hits, 1, 100000);
+  requirePositive("tracker_walk_distance", walk_distance);
+  requireInRange("tracker_walk_distance", walk_distance, 0.0, 10.0);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -180,14 +185,22 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     clusters[c].push_back(i);
   }
   std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
+  std::vector<int> split;  // step background split: the non-background returns of the clusters dropped
+  auto dropped = [&](const std::vector<int>& idx) {
+    if (!background || !p.background_split) return;
+    for (int i : idx)
+      if (!(*background)[i]) split.push_back(i);
+  };
   for (const std::vector<int>& idx : clusters)
   {
     if (static_cast<int>(idx.size()) < p.min_cluster_points) continue;
+    bool on_background_mostly = false;
     if (background && p.background_share < 1.0)
     {
       std::size_t on_background = 0;
       for (int i : idx) on_background += (*background)[i] != 0;
-      if (static_cast<double>(on_background) > p.background_share * static_cast<double>(idx.size())) continue;
+      on_background_mostly = static_cast<double>(on_background) > p.background_share * static_cast<double>(idx.size());
+      if (on_background_mostly && !p.background_split) continue;
     }
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (int i : idx) mean += Eigen::Vector2d(points[i].x, points[i].y);
@@ -213,7 +226,12 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     Measurement m;
     m.length = hi_u - lo_u;
     m.width = hi_v - lo_v;
-    if (m.length > p.max_object_length || m.width > p.max_object_width) continue;
+    if (m.length > p.max_object_length || m.width > p.max_object_width)
+    {
+      dropped(idx);
+      continue;
+    }
+    if (on_background_mostly) continue;
     m.centroid = Point2{ mean.x(), mean.y() };
     m.lo_u = lo_u;
     m.hi_u = hi_u;
@@ -228,6 +246,19 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     axes << major, minor;
     m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
     ordered.emplace_back(*std::min_element(idx.begin(), idx.end()), m);
+  }
+  if (split.size() >= static_cast<std::size_t>(p.min_cluster_points))
+  {
+    std::vector<Point2> sub(split.size());
+    for (std::size_t k = 0; k < split.size(); ++k) sub[k] = points[split[k]];
+    for (Measurement& m : clusterReturns(sub, p, nullptr))
+    {
+      if (m.length > p.background_split_size || m.width > p.background_split_size) continue;
+      m.split = true;
+      for (int& i : m.returns) i = split[i];
+      const int first = *std::min_element(m.returns.begin(), m.returns.end());
+      ordered.emplace_back(first, std::move(m));
+    }
   }
   std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Measurement> out;
@@ -561,6 +592,7 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
   const std::vector<int>& idx = measurements_[t.measurement].returns;
   Sighting now;
   now.stamp = stamp;
+  now.position = t.position();
   const std::size_t n = std::min(idx.size(), static_cast<std::size_t>(kSightingPoints));
   now.points.reserve(n);
   for (std::size_t k = 0; k < n; ++k)
@@ -587,6 +619,18 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     {
       t.motion_seen = true;
       ++counts_.across_face;
+    }
+    if (!t.motion_seen && params_.walked && small && t.consecutive_hits >= params_.walk_min_hits &&
+        !t.sightings.empty())
+    {
+      const Sighting& earliest = t.sightings.front();
+      const double dt = stamp - earliest.stamp;
+      if (std::hypot(t.x(0) - earliest.position.x - common_motion_.x * dt,
+                     t.x(1) - earliest.position.y - common_motion_.y * dt) >= params_.walk_distance)
+      {
+        t.motion_seen = true;
+        ++counts_.walked;
+      }
     }
   }
   const double oldest = stamp - params_.free_space_time - kMinStep;
@@ -643,6 +687,8 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
     if (flagged) map_flags_.push_back((*background)[i]);
   }
   std::vector<Measurement> found = clusterReturns(map_points_, params_, flagged ? &map_flags_ : nullptr);
+  counts_.split_measurements +=
+      std::count_if(found.begin(), found.end(), [](const Measurement& m) { return m.split; });
   for (Measurement& m : found)
   {
     m.has_sensor = true;
@@ -762,6 +808,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     {
       const int m = *it;
       const Measurement& z = measurements_[m];
+      if (z.split && std::max(t.extent_length, t.extent_width) > params_.background_split_size) continue;
       const Point2 ref = referencePoint(t, z);
       const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
       if (y.norm() > params_.max_gate_distance) continue;

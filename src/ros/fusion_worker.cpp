@@ -775,6 +775,8 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
       status.add("common motion (last scan) [m/s]", "none");
     status.add("scans with a common motion", c.common_motion_scans);
     status.add("tracks whose motion was seen across their face", c.across_face);
+    status.add("tracks whose motion was seen by the distance they walked", c.walked);
+    status.add("measurements split off static background", c.split_measurements);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }
 }

@@ -1595,3 +1595,157 @@ TEST(Tracker, AcrossFaceParametersAreValidatedByName)
       { "tracker_across_sigmas", [](TrackerParams& p) { p.across_sigmas = -1.0; } },
       { "tracker_across_sigmas", [](TrackerParams& p) { p.across_sigmas = 11.0; } } });
 }
+
+namespace {
+
+/// A wall along y = 0 from x = 0 to @p wall_length (two rows of returns, every 0.05 m, on background) and a
+/// @p ped_length × 0.3 m block of returns from x = min(10, wall_length / 2), y = 0.3 (every 0.1 m: touching the
+/// wall's cells), on background when @p ped_on_background.
+std::vector<Measurement> wallAndPedestrian(const TrackerParams& p, double wall_length, double ped_length,
+                                           bool ped_on_background, bool flags = true)
+{
+  std::vector<Point2> pts;
+  std::vector<std::uint8_t> bg;
+  for (double x = 0.0; x <= wall_length + 1e-9; x += 0.05)
+    for (const double y : { 0.0, 0.1 })
+    {
+      pts.push_back(Point2{ x, y });
+      bg.push_back(1);
+    }
+  const double x0 = std::min(10.0, 0.5 * wall_length);
+  for (double x = x0; x <= x0 + ped_length + 1e-9; x += 0.1)
+    for (const double y : { 0.3, 0.4, 0.5, 0.6 })
+    {
+      pts.push_back(Point2{ x, y });
+      bg.push_back(ped_on_background ? 1 : 0);
+    }
+  return clusterReturns(pts, p, flags ? &bg : nullptr);
+}
+
+}  // namespace
+
+TEST(Tracker, BackgroundSplitFindsAPedestrianTouchingAWall)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.background_split);
+  ASSERT_DOUBLE_EQ(p.background_split_size, 1.0);
+  const std::vector<Measurement> found = wallAndPedestrian(p, 30.0, 0.4, false);
+  ASSERT_EQ(found.size(), 1u) << "the pedestrian, split off the 30 m wall it touches";
+  const Measurement& m = found[0];
+  EXPECT_TRUE(m.split);
+  EXPECT_EQ(m.points, 20);
+  EXPECT_NEAR(m.centroid.x, 10.2, 1e-9);
+  EXPECT_NEAR(m.centroid.y, 0.45, 1e-9);
+  EXPECT_NEAR(std::max(m.length, m.width), 0.4, 1e-9);
+  EXPECT_NEAR(std::min(m.length, m.width), 0.3, 1e-9);
+  EXPECT_EQ(m.returns.size(), 20u);
+
+  TrackerParams off = p;
+  off.background_split = false;
+  EXPECT_TRUE(wallAndPedestrian(off, 30.0, 0.4, false).empty()) << "without the step: one cluster too long";
+  EXPECT_TRUE(wallAndPedestrian(p, 30.0, 0.4, false, false).empty()) << "without background flags nothing tells them apart";
+  EXPECT_TRUE(wallAndPedestrian(p, 30.0, 0.4, true).empty()) << "returns on background are no piece";
+  EXPECT_TRUE(wallAndPedestrian(p, 30.0, 1.5, false).empty()) << "a piece longer than background_split_size";
+  TrackerParams larger = p;
+  larger.background_split_size = 2.0;
+  EXPECT_EQ(wallAndPedestrian(larger, 30.0, 1.5, false).size(), 1u);
+  EXPECT_TRUE(wallAndPedestrian(p, 5.0, 0.4, false).empty())
+      << "a short cluster dropped for its background share alone is not split";
+}
+
+namespace {
+
+Measurement piece(double x, double y, double length, double width, bool split)
+{
+  Measurement m = at(x, y, 0.15);
+  m.length = length;
+  m.width = width;
+  m.lo_u = -0.5 * length;
+  m.hi_u = 0.5 * length;
+  m.lo_v = -0.5 * width;
+  m.hi_v = 0.5 * width;
+  m.split = split;
+  return m;
+}
+
+/// A track of a @p length × @p width object at (10, 0) seen in 4 scans, then a 0.4 × 0.3 m piece at (10.2, 0) in the
+/// fifth: the consecutive hits of the first track after it.
+int hitsAfterAPiece(double length, double width, bool split)
+{
+  Tracker tracker{ TrackerParams{} };
+  for (int k = 0; k < 4; ++k) tracker.update(0.1 * k, { piece(10.0, 0.0, length, width, false) });
+  tracker.update(0.4, { piece(10.2, 0.0, 0.4, 0.3, split) });
+  const Track* t = byId(tracker, 1);
+  return t ? t->consecutive_hits : -1;
+}
+
+}  // namespace
+
+TEST(Tracker, BackgroundSplitPiecesFollowOnlySmallTracks)
+{
+  ASSERT_EQ(hitsAfterAPiece(4.0, 2.0, false), 5) << "a cluster of the car's: associated";
+  EXPECT_EQ(hitsAfterAPiece(4.0, 2.0, true), 0) << "a piece split off background: not the car's track";
+  EXPECT_EQ(hitsAfterAPiece(0.5, 0.4, true), 5) << "a pedestrian's track follows its pieces";
+}
+
+namespace {
+
+/// The first scan from which the track of a @p length × 0.4 m object walking along x at @p speed (from x = -2, returns
+/// every 0.1 m at y = 5.1 … 5.4) is moving, -1 if never within 2 s. The scan sees no free space anywhere: a
+/// pedestrian behind parked cars, whose ground is hidden.
+int walkUnseen(const TrackerParams& params, double speed, double length = 0.4, std::uint64_t* walked = nullptr)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < 20; ++k)
+  {
+    const double x0 = -2.0 + speed * 0.1 * k;
+    std::vector<Point2> points;
+    for (double u = 0.0; u <= length + 1e-9; u += 0.1)
+      for (const double y : { 5.1, 5.2, 5.3, 5.4 }) points.push_back(Point2{ x0 + u, y });
+    const std::vector<float> xy = flatten(points);
+    const ScanMassGrid scan = scanGrid(xy, [](Point2) { return false; });
+    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, &scan);
+    EXPECT_LE(tracker.tracks().size(), 1u);
+    if (walked) *walked = tracker.counts().walked;
+    if (!tracker.tracks().empty() && tracker.tracks()[0].motion == TrackMotion::kMoving) return k;
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(Tracker, WalkedLetsAPedestrianWhoseGroundIsHiddenMove)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.walked);
+  ASSERT_EQ(p.walk_min_hits, 10);
+  ASSERT_DOUBLE_EQ(p.walk_distance, 0.5);
+  std::uint64_t walked = 0;
+  const int from = walkUnseen(p, 0.8, 0.4, &walked);
+  EXPECT_EQ(walked, 1u) << "counted";
+  // Scan 9 is its 10th association; it moved 0.72 m since its first sighting, 0.9 s before.
+  EXPECT_EQ(from, p.walk_min_hits - 1);
+  TrackerParams off = p;
+  off.walked = false;
+  EXPECT_EQ(walkUnseen(off, 0.8), -1) << "free space never shows its motion";
+  TrackerParams longer = p;
+  longer.walk_min_hits = 15;
+  EXPECT_EQ(walkUnseen(longer, 0.8), 14);
+  TrackerParams farther = p;
+  farther.walk_distance = 1.0;
+  EXPECT_EQ(walkUnseen(farther, 0.8), -1) << "0.8 m/s covers at most 0.88 m within the sightings kept (1 s)";
+  EXPECT_EQ(walkUnseen(p, 0.0), -1) << "a pedestrian standing still";
+  EXPECT_EQ(walkUnseen(p, 0.8, 2.0), -1) << "a 2 m object is no small walker";
+}
+
+TEST(Tracker, BackgroundSplitAndWalkedParametersAreValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_background_split_size", [](TrackerParams& p) { p.background_split_size = 0.0; } },
+      { "tracker_background_split_size", [](TrackerParams& p) { p.background_split_size = 5.0; } },
+      { "tracker_background_split_size", [](TrackerParams& p) { p.background_split_size = std::nan(""); } },
+      { "tracker_walk_min_hits", [](TrackerParams& p) { p.walk_min_hits = 0; } },
+      { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = 0.0; } },
+      { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = 11.0; } },
+      { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = std::nan(""); } } });
+}

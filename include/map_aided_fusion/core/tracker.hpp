@@ -44,6 +44,14 @@ struct TrackerParams
   /// tracks. Without a prior BetP(C) is 0 and the step does nothing.
   bool building_background = true;
   double background_building = 0.5;  ///< BetP(C) in [0, 1] above which a return lies on a mapped building
+  /// Step "background split": a pedestrian walking beside a wall, a hedge or a row of parked cars touches them, and
+  /// its returns join their cluster, longer than max_object_length or wider than max_object_width, which is no
+  /// measurement. The returns of such a cluster that do not lie on static background (background_zeta, step building
+  /// background) are clustered again, and those pieces at most background_split_size long and wide are measurements
+  /// (Measurement::split). A piece is associated only with a track whose box is at most that size: a vehicle's
+  /// track does not jump to a piece of it.
+  bool background_split = true;
+  double background_split_size = 1.0;  ///< m in (0, max_object_width]: a pedestrian's size
   double max_object_length = 18.0;   ///< m: a longer cluster (a wall, a fence, a hedge) is no object; an articulated bus is shorter
   double max_object_width = 4.0;     ///< m: a wider cluster is no object
   double measurement_sigma = 0.15;   ///< m, standard deviation of a compact cluster's centroid
@@ -182,6 +190,14 @@ struct TrackerParams
   double across_min_length = 1.0;       ///< m
   double across_max_width_share = 0.3;  ///< (0, 1]
   double across_sigmas = 3.0;
+  /// Step "walked" (free-space check): a pedestrian on a pavement behind parked cars is hidden from the ground around
+  /// it, so free space never shows where it left or came. A track checked as a small walker (step small free space)
+  /// that was associated in each of its last walk_min_hits scans and whose position moved at least walk_distance,
+  /// relative to the common motion, since its oldest sighting the check keeps (free_space_time ago) has shown its
+  /// motion as the free-space check would.
+  bool walked = true;
+  int walk_min_hits = 10;      ///< consecutive associations
+  double walk_distance = 0.5;  ///< m in (0, 10]
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -198,6 +214,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_background_share", p.background_share, { "", "a cluster with more than this share of background returns is not tracked; 1: off" });
   get("tracker_building_background", p.building_background, { "", "step building background: a return on a cell decided mapped building (BetP(C) above tracker_background_building) lies on static background too" });
   get("tracker_background_building", p.background_building, { "", "BetP(C) above which a return lies on a mapped building" });
+  get("tracker_background_split", p.background_split, { "", "step background split: the returns of a cluster too long or wide that are not on background are clustered again; pieces of a pedestrian's size are measurements" });
+  get("tracker_background_split_size", p.background_split_size, { "m", "longest and widest piece of step background split, and largest track box it may be associated with" });
   get("tracker_max_object_length", p.max_object_length, { "m", "a longer cluster (wall, fence, hedge) is no object" });
   get("tracker_max_object_width", p.max_object_width, { "m", "a wider cluster is no object" });
   get("tracker_measurement_sigma", p.measurement_sigma, { "m", "standard deviation of a compact cluster's centroid" });
@@ -253,6 +271,9 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_across_min_length", p.across_min_length, { "m", "shortest cluster that is a face" });
   get("tracker_across_max_width_share", p.across_max_width_share, { "", "largest width of a face, as a share of its length" });
   get("tracker_across_sigmas", p.across_sigmas, { "", "standard deviations by which the speed across the face must clear tracker_moving_speed" });
+  get("tracker_walked", p.walked, { "", "step walked: a small walker seen in each of its last tracker_walk_min_hits scans that moved tracker_walk_distance since its oldest sighting has shown its motion as free space would" });
+  get("tracker_walk_min_hits", p.walk_min_hits, { "scans", "consecutive associations a track needs before step walked" });
+  get("tracker_walk_distance", p.walk_distance, { "m", "how far a small walker must have moved since its oldest sighting (step walked)" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -293,6 +314,7 @@ struct Measurement
   bool ends_seen = false;
   static constexpr std::uint8_t kLowU = 1, kHighU = 2, kLowV = 4, kHighV = 8;
   std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
+  bool split = false;  ///< a piece of a cluster dropped for its background, clustered again (step background split)
 };
 
 /// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
@@ -325,7 +347,9 @@ bool hiddenFromSensor(const ScanMassGrid& scan, const Pose2& pose, Point2 p, dou
  * @brief Clusters map-frame returns: cells of cluster_distance / 2 holding returns, 8-connected, are one cluster.
  *        Clusters with fewer than min_cluster_points returns, longer than max_object_length or wider than
  *        max_object_width, or (with @p background, one flag per point) with more than background_share of their
- *        returns on background are dropped; non-finite points are skipped.
+ *        returns on background are dropped; non-finite points are skipped. With @p background and step background
+ *        split, the returns not on background of the clusters too long or wide are clustered again: the pieces at
+ *        most background_split_size long and wide are measurements too, with Measurement::split set.
  */
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& params,
                                         const std::vector<std::uint8_t>* background = nullptr);
@@ -351,6 +375,7 @@ struct Sighting
 {
   double stamp = 0.0;
   std::vector<Point2> points;
+  Point2 position;  ///< the track's position after this sighting's association (step walked)
 };
 
 /// The box a moving track reported in its last scan with a measurement (objectBox()), relative to its position and
@@ -414,6 +439,8 @@ struct TrackerCounts
   std::uint64_t duplicates = 0;         ///< moving tracks deleted as duplicates of another (step duplicates)
   std::uint64_t common_motion_scans = 0;  ///< scans with a common motion (step common motion)
   std::uint64_t across_face = 0;  ///< tracks whose motion was seen across their face (step across its face)
+  std::uint64_t walked = 0;       ///< tracks whose motion was seen by the distance they walked (step walked)
+  std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
