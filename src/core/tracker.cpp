@@ -185,11 +185,24 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     clusters[c].push_back(i);
   }
   std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
-  std::vector<int> split;  // step background split: the non-background returns of the clusters dropped
-  auto dropped = [&](const std::vector<int>& idx) {
+  std::vector<int> split;  // step background split: the returns off background of the clusters too large
+  auto tooLarge = [&](const std::vector<int>& idx) {
     if (!background || !p.background_split) return;
     for (int i : idx)
       if (!(*background)[i]) split.push_back(i);
+  };
+  // A cluster's extent along any axis is at most its bounding box's diagonal.
+  const double smallest_limit = std::min(p.max_object_length, p.max_object_width);
+  auto mayBeTooLarge = [&](const std::vector<int>& idx) {
+    double lx = 1e300, ly = 1e300, hx = -1e300, hy = -1e300;
+    for (int i : idx)
+    {
+      lx = std::min(lx, points[i].x);
+      ly = std::min(ly, points[i].y);
+      hx = std::max(hx, points[i].x);
+      hy = std::max(hy, points[i].y);
+    }
+    return std::hypot(hx - lx, hy - ly) > smallest_limit;
   };
   for (const std::vector<int>& idx : clusters)
   {
@@ -200,7 +213,8 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
       std::size_t on_background = 0;
       for (int i : idx) on_background += (*background)[i] != 0;
       on_background_mostly = static_cast<double>(on_background) > p.background_share * static_cast<double>(idx.size());
-      if (on_background_mostly && !p.background_split) continue;
+      // Step background split needs the extents of such a cluster only when it may be too large.
+      if (on_background_mostly && (!p.background_split || !mayBeTooLarge(idx))) continue;
     }
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (int i : idx) mean += Eigen::Vector2d(points[i].x, points[i].y);
@@ -228,7 +242,7 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     m.width = hi_v - lo_v;
     if (m.length > p.max_object_length || m.width > p.max_object_width)
     {
-      dropped(idx);
+      tooLarge(idx);
       continue;
     }
     if (on_background_mostly) continue;

@@ -314,7 +314,7 @@ struct Measurement
   bool ends_seen = false;
   static constexpr std::uint8_t kLowU = 1, kHighU = 2, kLowV = 4, kHighV = 8;
   std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
-  bool split = false;  ///< a piece of a cluster dropped for its background, clustered again (step background split)
+  bool split = false;  ///< step background split: a piece of the returns off background of a cluster too large
 };
 
 /// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
