@@ -110,6 +110,9 @@ const std::vector<AddedStep>& addedSteps()
     { "walked", "a small walker seen in each of its last scans that moved far enough has shown its motion as free space would",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.walked; },
       [](Profile& p) { p.tracker.walked = false; } },
+    { "second_axes", "a new track whose first cluster was nearly as wide as long takes the axes of its elongated, longer second cluster",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.second_axes; },
+      [](Profile& p) { p.tracker.second_axes = false; } },
   };
   return steps;
 }

@@ -26,6 +26,7 @@ constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks th
 constexpr double kOccluderGap = 1.0;   // m: an occluder lies at least this much nearer the sensor than an end it cuts
 constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
+constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): step second axes leaves a box this near the cluster's axes
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
@@ -100,6 +101,10 @@ void TrackerParams::validate() const
   requireInRange("tracker_walk_min_hits", walk_min_hits, 1, 100000);
   requirePositive("tracker_walk_distance", walk_distance);
   requireInRange("tracker_walk_distance", walk_distance, 0.0, 10.0);
+  requireUnit("tracker_second_axes_round", second_axes_round);
+  requirePositive("tracker_second_axes_elongation", second_axes_elongation);
+  requireInRange("tracker_second_axes_elongation", second_axes_elongation, 0.0, 1.0);
+  requireInRange("tracker_second_axes_growth", second_axes_growth, 1.0, 100.0);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -350,6 +355,24 @@ namespace {
 bool anchored(const Track& t, const Measurement& m)
 {
   return m.has_sensor && t.extent_length > 0.0 && m.hi_u - m.lo_u > 0.0;
+}
+
+/// Step second axes (TrackerParams::second_axes): turns the box of @p t, seen once, to the axes of its second cluster
+/// @p m when the first had none and @p m has. True when it turned.
+bool takeSecondAxes(Track& t, const Measurement& m, const TrackerParams& p)
+{
+  if (!p.second_axes || t.hits != 1) return false;
+  if (!(t.extent_width >= p.second_axes_round * t.extent_length)) return false;
+  if (!(m.width <= p.second_axes_elongation * m.length) || !(m.length > p.second_axes_growth * t.extent_length))
+    return false;
+  const double turn = std::remainder(m.yaw - t.extent_yaw, M_PI);
+  if (!(std::abs(turn) > kMinAxesTurn)) return false;
+  const double c = std::abs(std::cos(turn)), s = std::abs(std::sin(turn));
+  const double length = t.extent_length, width = t.extent_width;
+  t.extent_yaw = m.yaw;
+  t.extent_length = length * c + width * s;
+  t.extent_width = length * s + width * c;
+  return true;
 }
 
 /// Offset of the track's box centre from the centroid along one axis: the middle of the cluster when it is as long as
@@ -838,6 +861,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     Track& t = tracks_[r];
     if (pairs[r] >= 0)
     {
+      if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
       correct(t, measurements_[pairs[r]], stamp);
       used[pairs[r]] = 1;
       t.measurement = pairs[r];

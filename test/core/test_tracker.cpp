@@ -1749,3 +1749,120 @@ TEST(Tracker, BackgroundSplitAndWalkedParametersAreValidatedByName)
       { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = 11.0; } },
       { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = std::nan(""); } } });
 }
+
+namespace {
+
+constexpr double kCornerYaw = 0.37, kCornerLength = 1.10, kCornerWidth = 0.53;
+
+/// A cluster along x at y = 2.4 from @p front to @p front + @p length, seen from (20, 42): its −x end (the front of a car
+/// driving along −x) open, its +x end occluded while the car is still partly in a shadow.
+Measurement sideOf(double front, double length, double width, bool in_shadow)
+{
+  Measurement m = at(front + 0.5 * length, 2.4, 0.15);
+  m.length = length;
+  m.width = width;
+  m.lo_u = -0.5 * length;
+  m.hi_u = 0.5 * length;
+  m.lo_v = -0.5 * width;
+  m.hi_v = 0.5 * width;
+  m.has_sensor = true;
+  m.sensor = Point2{ 20.0, 42.0 };
+  m.ends_seen = true;
+  m.open = Measurement::kLowU;
+  m.occluded = in_shadow ? Measurement::kHighU : 0;
+  return m;
+}
+
+/// A 4.5 m car driving along −x at 12 m/s comes out of a shadow whose edge is at x = 10.4: first its corner, a
+/// @p corner_length × @p corner_width cluster whose axes are @p corner_yaw off the car's, then its side, a
+/// @p side_width wide cluster from its front to the shadow's edge (scan 1: 3.15 m). After @p scans scans: the track the
+/// corner started, and how many tracks there are in @p tracks.
+Track comeOutOfAShadow(const TrackerParams& params, int scans, std::uint64_t* turned = nullptr, std::size_t* tracks = nullptr,
+                       double corner_yaw = kCornerYaw, double corner_length = kCornerLength,
+                       double corner_width = kCornerWidth, double side_width = 0.08, double edge = 10.4)
+{
+  Tracker tracker(params);
+  Measurement corner = sideOf(8.45, corner_length, corner_width, true);
+  corner.centroid = Point2{ 9.0, 2.3 };
+  corner.yaw = corner_yaw;
+  tracker.update(0.0, { corner });
+  for (int k = 1; k < scans; ++k)
+  {
+    const double front = 8.45 - 1.2 * k, length = std::min(4.5, edge - front);
+    tracker.update(0.1 * k, { sideOf(front, length, side_width, length < 4.5) });
+  }
+  if (turned) *turned = tracker.counts().second_axes;
+  if (tracks) *tracks = tracker.tracks().size();
+  const Track* first = byId(tracker, 1);
+  return first ? *first : Track{};
+}
+
+}  // namespace
+
+TEST(Tracker, SecondAxesTurnTheBoxOfACarWhoseCornerCameFirst)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.second_axes);
+  ASSERT_DOUBLE_EQ(p.second_axes_round, 0.4);
+  ASSERT_DOUBLE_EQ(p.second_axes_elongation, 0.5);
+  ASSERT_DOUBLE_EQ(p.second_axes_growth, 1.5);
+  std::uint64_t turned = 0;
+  const Track second = comeOutOfAShadow(p, 2, &turned);
+  ASSERT_EQ(second.hits, 2);
+  EXPECT_EQ(turned, 1u) << "counted";
+  EXPECT_DOUBLE_EQ(second.extent_yaw, 0.0) << "the side's axes";
+  // Across: the corner's box seen along the side's axes, wider than the side (0.08 m), which cannot grow it.
+  EXPECT_DOUBLE_EQ(second.extent_width, kCornerLength * std::sin(kCornerYaw) + kCornerWidth * std::cos(kCornerYaw));
+  // Along: the corner's box seen along them (1.22 m) grew to the side's 3.15 m, away from the open front.
+  EXPECT_NEAR(second.extent_length, 3.15, 1e-9);
+
+  // Five scans on: the box anchored on the car's front follows it; without the step, the box keeps the corner's axes,
+  // 21° off the side's, too far for step open ends, and follows the shadow's edge that stands still.
+  std::size_t tracks = 0;
+  const Track with = comeOutOfAShadow(p, 5, nullptr, &tracks);
+  EXPECT_EQ(tracks, 1u);
+  EXPECT_EQ(with.hits, 5);
+  TrackerParams off = p;
+  off.second_axes = false;
+  std::uint64_t off_turned = 0;
+  const Track without = comeOutOfAShadow(off, 5, &off_turned);
+  ASSERT_GT(without.id, 0u);
+  EXPECT_EQ(off_turned, 0u);
+  EXPECT_DOUBLE_EQ(without.extent_yaw, kCornerYaw);
+  const double err_with = std::hypot(with.x(2) + 12.0, with.x(3)), err_without = std::hypot(without.x(2) + 12.0, without.x(3));
+  EXPECT_LT(err_with, 0.5 * err_without) << "vx with " << with.x(2) << ", without " << without.x(2);
+}
+
+TEST(Tracker, SecondAxesLeaveABoxWithAnAxisOrAClusterWithout)
+{
+  TrackerParams p;
+  auto keeps = [&](const TrackerParams& params, double corner_yaw, double corner_length, double corner_width,
+                   double side_width, double edge) {
+    std::uint64_t turned = 0;
+    const Track t = comeOutOfAShadow(params, 2, &turned, nullptr, corner_yaw, corner_length, corner_width, side_width, edge);
+    return turned == 0 && t.extent_yaw == corner_yaw;
+  };
+  ASSERT_FALSE(keeps(p, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 10.4)) << "the scene above turns";
+  EXPECT_TRUE(keeps(p, kCornerYaw, kCornerLength, 0.4, 0.08, 10.4)) << "a first cluster 0.4 × 1.1 m has an axis";
+  EXPECT_TRUE(keeps(p, kCornerYaw, kCornerLength, kCornerWidth, 1.6, 10.4)) << "a 3.15 × 1.6 m side has none";
+  EXPECT_TRUE(keeps(p, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 8.8)) << "1.55 m: not longer than 1.5 × 1.1 m";
+  EXPECT_TRUE(keeps(p, 0.05, kCornerLength, kCornerWidth, 0.08, 10.4)) << "within 6° of the side's axes";
+  TrackerParams rounder = p;
+  rounder.second_axes_round = 0.5;
+  EXPECT_TRUE(keeps(rounder, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 10.4)) << "0.53 / 1.1 < 0.5";
+  TrackerParams growth = p;
+  growth.second_axes_growth = 3.0;
+  EXPECT_TRUE(keeps(growth, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 10.4)) << "3.15 m < 3 × 1.1 m";
+}
+
+TEST(Tracker, SecondAxesParametersAreValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_second_axes_round", [](TrackerParams& p) { p.second_axes_round = -0.1; } },
+      { "tracker_second_axes_round", [](TrackerParams& p) { p.second_axes_round = 1.5; } },
+      { "tracker_second_axes_round", [](TrackerParams& p) { p.second_axes_round = std::nan(""); } },
+      { "tracker_second_axes_elongation", [](TrackerParams& p) { p.second_axes_elongation = 0.0; } },
+      { "tracker_second_axes_elongation", [](TrackerParams& p) { p.second_axes_elongation = 1.5; } },
+      { "tracker_second_axes_growth", [](TrackerParams& p) { p.second_axes_growth = 0.5; } },
+      { "tracker_second_axes_growth", [](TrackerParams& p) { p.second_axes_growth = std::nan(""); } } });
+}

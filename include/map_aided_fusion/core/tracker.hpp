@@ -198,6 +198,16 @@ struct TrackerParams
   bool walked = true;
   int walk_min_hits = 10;      ///< consecutive associations
   double walk_distance = 0.5;  ///< m in (0, 10]
+  /// Step "second axes": a new track's box takes the axes of its first cluster, which has none when it is nearly as
+  /// wide as long: the corner of a car coming out of a shadow, whose axes can be 20° off the car's, so that the point
+  /// the track follows (referencePoint()) moves across the car as its side grows. When the track's second cluster is
+  /// elongated and much longer than the first, the box turns to the second cluster's axes (unless within 6° of them)
+  /// before that cluster corrects the track; its extents become those of the old box seen along the new axes (the
+  /// rectangle around it).
+  bool second_axes = true;
+  double second_axes_round = 0.4;       ///< [0, 1]: a first cluster at least this wide for its length has no axis
+  double second_axes_elongation = 0.5;  ///< (0, 1]: a second cluster at most this wide for its length has one
+  double second_axes_growth = 1.5;      ///< [1, 100]: and is longer than this many times the first's length
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -274,6 +284,10 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_walked", p.walked, { "", "step walked: a small walker seen in each of its last tracker_walk_min_hits scans that moved tracker_walk_distance since its oldest sighting has shown its motion as free space would" });
   get("tracker_walk_min_hits", p.walk_min_hits, { "scans", "consecutive associations a track needs before step walked" });
   get("tracker_walk_distance", p.walk_distance, { "m", "how far a small walker must have moved since its oldest sighting (step walked)" });
+  get("tracker_second_axes", p.second_axes, { "", "step second axes: a new track whose first cluster was nearly as wide as long takes the axes of its second cluster when that one is elongated and much longer" });
+  get("tracker_second_axes_round", p.second_axes_round, { "", "a first cluster at least this wide for its length has no axis (step second axes)" });
+  get("tracker_second_axes_elongation", p.second_axes_elongation, { "", "a second cluster at most this wide for its length has an axis (step second axes)" });
+  get("tracker_second_axes_growth", p.second_axes_growth, { "", "the second cluster must be longer than this many times the first (step second axes)" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -441,6 +455,7 @@ struct TrackerCounts
   std::uint64_t across_face = 0;  ///< tracks whose motion was seen across their face (step across its face)
   std::uint64_t walked = 0;       ///< tracks whose motion was seen by the distance they walked (step walked)
   std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
+  std::uint64_t second_axes = 0;  ///< new tracks whose box turned to their second cluster's axes (step second axes)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
