@@ -113,6 +113,9 @@ const std::vector<AddedStep>& addedSteps()
     { "second_axes", "a new track whose first cluster was nearly as wide as long takes the axes of its elongated, longer second cluster",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.second_axes; },
       [](Profile& p) { p.tracker.second_axes = false; } },
+    { "hidden_ends", "a cluster whose two ends are hidden and neither open (a car seen through a gap) tells a track not yet moving nothing along its axis",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.hidden_ends; },
+      [](Profile& p) { p.tracker.hidden_ends = false; } },
   };
   return steps;
 }

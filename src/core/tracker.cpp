@@ -26,6 +26,7 @@ constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks th
 constexpr double kOccluderGap = 1.0;   // m: an occluder lies at least this much nearer the sensor than an end it cuts
 constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
+constexpr double kMaxHiddenEndsSigma = 100.0;  // m: hidden_ends_sigma, far beyond any object
 constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): step second axes leaves a box this near the cluster's axes
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
@@ -36,13 +37,24 @@ std::int64_t cellKey(std::int64_t x, std::int64_t y) { return (x << 32) ^ (y & 0
 
 bool finite(const Eigen::Vector4d& x, const Eigen::Matrix4d& p) { return x.allFinite() && p.allFinite(); }
 
+/// Step hidden ends (TrackerParams::hidden_ends): @p m's two ends along its major axis are hidden and neither is open,
+/// and @p t is not yet moving.
+bool hiddenEnds(const Track& t, const Measurement& m, const TrackerParams& p)
+{
+  constexpr std::uint8_t kEnds = Measurement::kLowU | Measurement::kHighU;
+  return p.hidden_ends && t.motion != TrackMotion::kMoving && m.ends_seen && (m.occluded & kEnds) == kEnds &&
+         !(m.open & kEnds);
+}
+
 /// The measurement's covariance, grown by the change of the cluster's extent since the track's last cluster: a
-/// partially seen object's centroid is off by up to half the part not seen.
-Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m)
+/// partially seen object's centroid is off by up to half the part not seen; with step hidden ends, by
+/// hidden_ends_sigma along the major axis of a cluster whose ends are hidden.
+Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, const TrackerParams& p)
 {
   const double dl = 0.5 * std::abs(m.length - t.length), dw = 0.5 * std::abs(m.width - t.width);
   const Eigen::Vector2d major(std::cos(m.yaw), std::sin(m.yaw)), minor(-major.y(), major.x());
-  return m.covariance + dl * dl * major * major.transpose() + dw * dw * minor * minor.transpose();
+  const double along = dl * dl + (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
+  return m.covariance + along * major * major.transpose() + dw * dw * minor * minor.transpose();
 }
 
 }  // namespace
@@ -105,6 +117,8 @@ void TrackerParams::validate() const
   requirePositive("tracker_second_axes_elongation", second_axes_elongation);
   requireInRange("tracker_second_axes_elongation", second_axes_elongation, 0.0, 1.0);
   requireInRange("tracker_second_axes_growth", second_axes_growth, 1.0, 100.0);
+  requirePositive("tracker_hidden_ends_sigma", hidden_ends_sigma);
+  requireInRange("tracker_hidden_ends_sigma", hidden_ends_sigma, 0.0, kMaxHiddenEndsSigma);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -486,7 +500,7 @@ void Tracker::predict(Track& t, double dt) const
 
 void Tracker::correct(Track& t, const Measurement& m, double stamp) const
 {
-  const Eigen::Matrix2d r = measurementCovariance(t, m);
+  const Eigen::Matrix2d r = measurementCovariance(t, m, params_);
   const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + r;
   const Eigen::Matrix<double, 4, 2> k = t.P.leftCols<2>() * s.inverse();
   const Point2 ref = referencePoint(t, m);
@@ -849,7 +863,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       const Point2 ref = referencePoint(t, z);
       const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
       if (y.norm() > params_.max_gate_distance) continue;
-      const Eigen::Matrix2d sm = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z);
+      const Eigen::Matrix2d sm = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z, params_);
       const double d2 = y.dot(sm.ldlt().solve(y));
       if (std::isfinite(d2) && d2 <= params_.gate) cost.at(r, m) = d2;
     }
@@ -862,6 +876,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     if (pairs[r] >= 0)
     {
       if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
+      if (hiddenEnds(t, measurements_[pairs[r]], params_)) ++counts_.hidden_ends;
       correct(t, measurements_[pairs[r]], stamp);
       used[pairs[r]] = 1;
       t.measurement = pairs[r];

@@ -1866,3 +1866,83 @@ TEST(Tracker, SecondAxesParametersAreValidatedByName)
       { "tracker_second_axes_growth", [](TrackerParams& p) { p.second_axes_growth = 0.5; } },
       { "tracker_second_axes_growth", [](TrackerParams& p) { p.second_axes_growth = std::nan(""); } } });
 }
+
+namespace {
+
+/// Scans 0 … @p scans − 1 of a car's side at y = 2.4 seen from (20, 42) through a 2 m gap between two parked cars: a
+/// cluster 2 m long whose centroid drifts from x = 11.4 at @p gap_speed (the gap's edges move as the vehicle drives),
+/// both its ends hidden and neither open (@p ends: Measurement::occluded; open none). With @p moving_first, a car
+/// driving along −x at 12 m/s seen whole for eight scans first (both ends open), then its rear 2 m at its speed.
+Tracker throughAGap(const TrackerParams& params, int scans, double gap_speed, bool moving_first,
+                    std::uint8_t ends = Measurement::kLowU | Measurement::kHighU)
+{
+  Tracker tracker(params);
+  double t = 0.0;
+  if (moving_first)
+    for (int k = 0; k < 8; ++k, t += 0.1)
+    {
+      Measurement whole = sideOf(20.0 - 1.2 * k, 4.5, 0.08, false);
+      whole.open = Measurement::kLowU | Measurement::kHighU;
+      tracker.update(t, { whole });
+    }
+  // After the whole car, the view is its last 2 m, so that its end nearest the sensor is the car's.
+  const double start = moving_first ? 20.0 - 1.2 * 8 + 4.5 - 2.0 : 10.4;
+  for (int k = 0; k < scans; ++k, t += 0.1)
+  {
+    Measurement view = sideOf(start + gap_speed * 0.1 * k, 2.0, 0.08, false);
+    view.open = 0;
+    view.occluded = ends;
+    tracker.update(t, { view });
+  }
+  return tracker;
+}
+
+}  // namespace
+
+TEST(Tracker, HiddenEndsKeepACarSeenThroughAGapFromMovingWithTheGap)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.hidden_ends);
+  ASSERT_DOUBLE_EQ(p.hidden_ends_sigma, 5.0);
+  p.free_space_check = false;  // no ScanGrid here: the speed alone decides
+  TrackerParams off = p;
+  off.hidden_ends = false;
+  const Tracker without = throughAGap(off, 8, -2.0, false);
+  ASSERT_EQ(without.tracks().size(), 1u);
+  EXPECT_EQ(without.tracks()[0].motion, TrackMotion::kMoving) << "the gap's drift, taken for the car's motion";
+  EXPECT_NEAR(without.tracks()[0].x(2), -2.0, 0.5);
+  const Tracker with = throughAGap(p, 8, -2.0, false);
+  ASSERT_EQ(with.tracks().size(), 1u);
+  EXPECT_NE(with.tracks()[0].motion, TrackMotion::kMoving);
+  EXPECT_EQ(with.counts().hidden_ends, 7u) << "every association after the first";
+  EXPECT_EQ(without.counts().hidden_ends, 0u);
+  // Across the axis the views still tell where the object is: no speed across it.
+  EXPECT_NEAR(with.tracks()[0].x(3), 0.0, 1e-9);
+}
+
+TEST(Tracker, HiddenEndsLeaveAMovingTrackAndAViewWithAnEnd)
+{
+  TrackerParams p;
+  p.free_space_check = false;
+  TrackerParams off = p;
+  off.hidden_ends = false;
+  auto same = [](const Tracker& a, const Tracker& b) {
+    return a.tracks().size() == 1u && b.tracks().size() == 1u && a.tracks()[0].x == b.tracks()[0].x &&
+           a.tracks()[0].P == b.tracks()[0].P;
+  };
+  const Tracker moving = throughAGap(p, 3, -12.0, true);
+  ASSERT_EQ(moving.tracks().size(), 1u);
+  EXPECT_EQ(moving.tracks()[0].motion, TrackMotion::kMoving);
+  EXPECT_TRUE(same(moving, throughAGap(off, 3, -12.0, true))) << "a moving track: bit for bit as without the step";
+  EXPECT_EQ(moving.counts().hidden_ends, 0u);
+  EXPECT_TRUE(same(throughAGap(p, 8, -2.0, false, Measurement::kLowU), throughAGap(off, 8, -2.0, false, Measurement::kLowU)))
+      << "one end not hidden";
+}
+
+TEST(Tracker, HiddenEndsSigmaIsValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = 0.0; } },
+      { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = 101.0; } },
+      { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = std::nan(""); } } });
+}

@@ -208,6 +208,14 @@ struct TrackerParams
   double second_axes_round = 0.4;       ///< [0, 1]: a first cluster at least this wide for its length has no axis
   double second_axes_elongation = 0.5;  ///< (0, 1]: a second cluster at most this wide for its length has one
   double second_axes_growth = 1.5;      ///< [1, 100]: and is longer than this many times the first's length
+  /// Step "hidden ends" (with step open ends, which finds the hidden ends): a cluster whose two ends along its major
+  /// axis are both hidden from the sensor by nearer obstacles, neither with free space beyond it, is the part of an
+  /// object seen through a gap: its extent along that axis is the gap's, and its centroid moves with neither end of the
+  /// object (a car passing behind two parked cars). For a track not yet moving, the measurement's σ along that axis
+  /// grows by hidden_ends_sigma, so that such views do not make it moving with the gap's motion. A moving track keeps
+  /// the usual σ (its velocity is known; measured, the larger σ made a turning van lag).
+  bool hidden_ends = true;
+  double hidden_ends_sigma = 5.0;  ///< m in (0, 100]
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -288,6 +296,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_second_axes_round", p.second_axes_round, { "", "a first cluster at least this wide for its length has no axis (step second axes)" });
   get("tracker_second_axes_elongation", p.second_axes_elongation, { "", "a second cluster at most this wide for its length has an axis (step second axes)" });
   get("tracker_second_axes_growth", p.second_axes_growth, { "", "the second cluster must be longer than this many times the first (step second axes)" });
+  get("tracker_hidden_ends", p.hidden_ends, { "", "step hidden ends: a cluster whose two ends along its major axis are hidden and neither open tells a track not yet moving nothing along that axis" });
+  get("tracker_hidden_ends_sigma", p.hidden_ends_sigma, { "m", "standard deviation added along such a cluster's major axis (step hidden ends)" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -456,6 +466,7 @@ struct TrackerCounts
   std::uint64_t walked = 0;       ///< tracks whose motion was seen by the distance they walked (step walked)
   std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
   std::uint64_t second_axes = 0;  ///< new tracks whose box turned to their second cluster's axes (step second axes)
+  std::uint64_t hidden_ends = 0;  ///< associations of a track not yet moving with a cluster whose ends are hidden (step hidden ends)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
