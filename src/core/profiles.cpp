@@ -116,6 +116,12 @@ const std::vector<AddedStep>& addedSteps()
     { "hidden_ends", "a cluster whose two ends are hidden and neither open (a car seen through a gap) tells a track not yet moving nothing along its axis",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.hidden_ends; },
       [](Profile& p) { p.tracker.hidden_ends = false; } },
+    { "box_fit", "a cluster's axes are those of the rectangle that fits its returns best, not its principal axes (a vehicle's L of rear and side)",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.box_fit; },
+      [](Profile& p) { p.tracker.box_fit = false; } },
+    { "open_anchor", "a cluster placed by its end nearest the sensor, with free space beyond it, has a compact cluster's sigma along its axis",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.open_anchor; },
+      [](Profile& p) { p.tracker.open_anchor = false; } },
   };
   return steps;
 }

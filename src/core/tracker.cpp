@@ -28,6 +28,9 @@ constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMaxHiddenEndsSigma = 100.0;  // m: hidden_ends_sigma, far beyond any object
 constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): step second axes leaves a box this near the cluster's axes
+constexpr double kMinBoxFitStep = 0.1;   // deg: box_fit_step, 900 rectangles a cluster
+constexpr double kMaxBoxFitStep = 45.0;  // deg: two rectangles, at 0° and 45°
+constexpr double kMaxBoxFitCloseness = 1.0;  // m: box_fit_closeness, beyond any object's edge
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
@@ -46,15 +49,77 @@ bool hiddenEnds(const Track& t, const Measurement& m, const TrackerParams& p)
          !(m.open & kEnds);
 }
 
+/// Step open anchor (TrackerParams::open_anchor): the end of @p m on which @p t's box is anchored along the cluster's
+/// major axis (viewAlong()) has free space beyond it.
+bool openAnchor(const Track& t, const Measurement& m, const TrackerParams& p)
+{
+  if (!p.open_anchor || !m.ends_seen || !m.has_sensor || !(t.extent_length > 0.0)) return false;
+  const AxisView a = viewAlong(m, Eigen::Vector2d(std::cos(m.yaw), std::sin(m.yaw)));
+  return (m.open & (a.anchor_lo ? Measurement::kLowU : Measurement::kHighU)) != 0;
+}
+
 /// The measurement's covariance, grown by the change of the cluster's extent since the track's last cluster: a
 /// partially seen object's centroid is off by up to half the part not seen; with step hidden ends, by
-/// hidden_ends_sigma along the major axis of a cluster whose ends are hidden.
+/// hidden_ends_sigma along the major axis of a cluster whose ends are hidden. With step open anchor, a cluster placed
+/// by its open end has measurement_sigma along its major axis instead of its own σ.
 Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, const TrackerParams& p)
 {
   const double dl = 0.5 * std::abs(m.length - t.length), dw = 0.5 * std::abs(m.width - t.width);
   const Eigen::Vector2d major(std::cos(m.yaw), std::sin(m.yaw)), minor(-major.y(), major.x());
   const double along = dl * dl + (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
+  if (openAnchor(t, m, p))
+  {
+    const double su = p.measurement_sigma, sv = p.measurement_sigma + p.extent_sigma * m.width;
+    return (su * su + along) * major * major.transpose() + (sv * sv + dw * dw) * minor * minor.transpose();
+  }
   return m.covariance + along * major * major.transpose() + dw * dw * minor * minor.transpose();
+}
+
+/// Step box fit (TrackerParams::box_fit): the axis of the rectangle that fits @p idx's returns best by the closeness
+/// criterion, as a unit vector within 90° of @p principal and along the rectangle's longer side.
+Eigen::Vector2d fittedAxis(const std::vector<Point2>& points, const std::vector<int>& idx, const Eigen::Vector2d& mean,
+                           const Eigen::Vector2d& principal, const TrackerParams& p)
+{
+  const std::size_t n = idx.size();
+  std::vector<double> dx(n), dy(n), u(n), v(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    dx[i] = points[idx[i]].x - mean.x();
+    dy[i] = points[idx[i]].y - mean.y();
+  }
+  const int tries = static_cast<int>(std::ceil(90.0 / p.box_fit_step - 1e-9));
+  const double closeness = p.box_fit_closeness;
+  double best_score = -1.0, best_angle = 0.0, best_lu = 0.0, best_lv = 0.0;
+  for (int k = 0; k < tries; ++k)
+  {
+    const double angle = k * p.box_fit_step * M_PI / 180.0, c = std::cos(angle), s = std::sin(angle);
+    double lo_u = 1e300, hi_u = -1e300, lo_v = 1e300, hi_v = -1e300;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      u[i] = dx[i] * c + dy[i] * s;
+      v[i] = dy[i] * c - dx[i] * s;
+      lo_u = std::min(lo_u, u[i]);
+      hi_u = std::max(hi_u, u[i]);
+      lo_v = std::min(lo_v, v[i]);
+      hi_v = std::max(hi_v, v[i]);
+    }
+    double score = 0.0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const double edge = std::min(std::min(u[i] - lo_u, hi_u - u[i]), std::min(v[i] - lo_v, hi_v - v[i]));
+      score += 1.0 / std::max(edge, closeness);
+    }
+    if (score > best_score)
+    {
+      best_score = score;
+      best_angle = angle;
+      best_lu = hi_u - lo_u;
+      best_lv = hi_v - lo_v;
+    }
+  }
+  const Eigen::Vector2d eu(std::cos(best_angle), std::sin(best_angle)), ev(-eu.y(), eu.x());
+  const Eigen::Vector2d axis = best_lu >= best_lv ? eu : ev;
+  return axis.dot(principal) < 0.0 ? Eigen::Vector2d(-axis) : axis;
 }
 
 }  // namespace
@@ -119,6 +184,10 @@ void TrackerParams::validate() const
   requireInRange("tracker_second_axes_growth", second_axes_growth, 1.0, 100.0);
   requirePositive("tracker_hidden_ends_sigma", hidden_ends_sigma);
   requireInRange("tracker_hidden_ends_sigma", hidden_ends_sigma, 0.0, kMaxHiddenEndsSigma);
+  requireInRange("tracker_box_fit_step", box_fit_step, kMinBoxFitStep, kMaxBoxFitStep);
+  requirePositive("tracker_box_fit_closeness", box_fit_closeness);
+  requireInRange("tracker_box_fit_closeness", box_fit_closeness, 0.0, kMaxBoxFitCloseness);
+  requireInRange("tracker_box_fit_min_length", box_fit_min_length, 0.0, max_object_length);
 }
 
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
@@ -245,18 +314,34 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
       scatter += d * d.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
-    const Eigen::Vector2d major = eig.eigenvectors().col(1);
-    const Eigen::Vector2d minor(-major.y(), major.x());
+    const Eigen::Vector2d principal = eig.eigenvectors().col(1);
+    Eigen::Vector2d major = principal;
     double lo_u = 1e300, hi_u = -1e300, lo_v = 1e300, hi_v = -1e300;
-    for (int i : idx)
+    auto extents = [&]() {
+      const Eigen::Vector2d minor(-major.y(), major.x());
+      lo_u = lo_v = 1e300;
+      hi_u = hi_v = -1e300;
+      for (int i : idx)
+      {
+        const Eigen::Vector2d d = Eigen::Vector2d(points[i].x, points[i].y) - mean;
+        lo_u = std::min(lo_u, d.dot(major));
+        hi_u = std::max(hi_u, d.dot(major));
+        lo_v = std::min(lo_v, d.dot(minor));
+        hi_v = std::max(hi_v, d.dot(minor));
+      }
+    };
+    extents();
+    bool fitted = false;
+    // A cluster longer than max_object_length · √2 along its principal axis is too long along any rectangle's.
+    if (p.box_fit && hi_u - lo_u >= p.box_fit_min_length && hi_u - lo_u <= M_SQRT2 * p.max_object_length)
     {
-      const Eigen::Vector2d d = Eigen::Vector2d(points[i].x, points[i].y) - mean;
-      lo_u = std::min(lo_u, d.dot(major));
-      hi_u = std::max(hi_u, d.dot(major));
-      lo_v = std::min(lo_v, d.dot(minor));
-      hi_v = std::max(hi_v, d.dot(minor));
+      major = fittedAxis(points, idx, mean, principal, p);
+      fitted = std::acos(std::min(1.0, std::abs(major.dot(principal)))) > p.box_fit_step * M_PI / 180.0;
+      extents();
     }
+    const Eigen::Vector2d minor(-major.y(), major.x());
     Measurement m;
+    m.fitted = fitted;
     m.length = hi_u - lo_u;
     m.width = hi_v - lo_v;
     if (m.length > p.max_object_length || m.width > p.max_object_width)
@@ -740,6 +825,7 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   std::vector<Measurement> found = clusterReturns(map_points_, params_, flagged ? &map_flags_ : nullptr);
   counts_.split_measurements +=
       std::count_if(found.begin(), found.end(), [](const Measurement& m) { return m.split; });
+  counts_.box_fit += std::count_if(found.begin(), found.end(), [](const Measurement& m) { return m.fitted; });
   for (Measurement& m : found)
   {
     m.has_sensor = true;
@@ -877,6 +963,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     {
       if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
       if (hiddenEnds(t, measurements_[pairs[r]], params_)) ++counts_.hidden_ends;
+      if (openAnchor(t, measurements_[pairs[r]], params_)) ++counts_.open_anchor;
       correct(t, measurements_[pairs[r]], stamp);
       used[pairs[r]] = 1;
       t.measurement = pairs[r];

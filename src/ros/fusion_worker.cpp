@@ -778,6 +778,8 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("tracks whose motion was seen by the distance they walked", c.walked);
     status.add("new tracks whose box took their second cluster's axes", c.second_axes);
     status.add("associations with a cluster whose ends were hidden (track not yet moving)", c.hidden_ends);
+    status.add("measurements whose fitted box turned off their principal axes", c.box_fit);
+    status.add("associations with a cluster placed by its open end", c.open_anchor);
     status.add("measurements split off static background", c.split_measurements);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }

@@ -594,6 +594,9 @@ TEST(Tracker, FreeSpaceMotionSigmasApplyOnlyWhileTheCheckRuns)
   TrackerParams p;
   ASSERT_DOUBLE_EQ(p.free_space_motion_sigmas, 0.5);
   ASSERT_DOUBLE_EQ(p.motion_sigmas, 1.5);
+  // Placed by its open rear end (step open anchor), the car's speed is certain enough for both thresholds by the
+  // scan free space shows its motion: without that step the scene tells them apart.
+  p.open_anchor = false;
   double s = 0.0, sigma = 0.0;
   const int relaxed = carMovingFrom(p, 1.5, true, s, sigma);
   ASSERT_GE(relaxed, 0);
@@ -1945,4 +1948,179 @@ TEST(Tracker, HiddenEndsSigmaIsValidatedByName)
       { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = 0.0; } },
       { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = 101.0; } },
       { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = std::nan(""); } } });
+}
+
+namespace {
+
+constexpr double kVehicleYaw = 30.0 * M_PI / 180.0;  // a multiple of tracker_box_fit_step (3°)
+constexpr double kVehicleLength = 4.5, kVehicleWidth = 1.8;
+
+/// The returns of a 4.5 × 1.8 m vehicle centred on (10, 5), heading kVehicleYaw, seen on its rear and its left side
+/// (an L, every 5 cm), or of a smaller L of @p length × @p width.
+std::vector<Point2> rearAndSide(double length = kVehicleLength, double width = kVehicleWidth)
+{
+  std::vector<Point2> out;
+  const double c = std::cos(kVehicleYaw), s = std::sin(kVehicleYaw);
+  auto add = [&](double u, double v) { out.push_back(Point2{ 10.0 + c * u - s * v, 5.0 + s * u + c * v }); };
+  const int along = static_cast<int>(std::lround(length / 0.05)), across = static_cast<int>(std::lround(width / 0.05));
+  for (int i = 0; i <= along; ++i) add(-0.5 * length + 0.05 * i, -0.5 * width);
+  for (int i = 1; i <= across; ++i) add(-0.5 * length, -0.5 * width + 0.05 * i);
+  return out;
+}
+
+/// The only measurement of @p points.
+Measurement onlyCluster(const std::vector<Point2>& points, const TrackerParams& p)
+{
+  const std::vector<Measurement> found = clusterReturns(points, p, nullptr);
+  EXPECT_EQ(found.size(), 1u);
+  return found.empty() ? Measurement{} : found[0];
+}
+
+}  // namespace
+
+TEST(Tracker, BoxFitTakesTheAxesOfAVehicleSeenOnItsRearAndSide)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.box_fit);
+  ASSERT_DOUBLE_EQ(p.box_fit_step, 3.0);
+  ASSERT_DOUBLE_EQ(p.box_fit_closeness, 0.05);
+  ASSERT_DOUBLE_EQ(p.box_fit_min_length, 1.5);
+  const Measurement fitted = onlyCluster(rearAndSide(), p);
+  EXPECT_TRUE(fitted.fitted);
+  EXPECT_NEAR(fitted.yaw, kVehicleYaw, 1e-12) << "the rectangle every return lies on";
+  EXPECT_NEAR(fitted.length, kVehicleLength, 1e-9);
+  EXPECT_NEAR(fitted.width, kVehicleWidth, 1e-9);
+  // The principal axes of the L lie between its two faces (11.4° off, towards the rear): its box is askew and
+  // longer than the vehicle.
+  TrackerParams off = p;
+  off.box_fit = false;
+  const Measurement principal = onlyCluster(rearAndSide(), off);
+  EXPECT_FALSE(principal.fitted);
+  EXPECT_GT(std::abs(std::remainder(principal.yaw - kVehicleYaw, M_PI)), 10.0 * M_PI / 180.0);
+  EXPECT_GT(principal.length, kVehicleLength + 0.2);
+  // The centroid is the returns' mean either way; the box around it is the vehicle's.
+  EXPECT_DOUBLE_EQ(fitted.centroid.x, principal.centroid.x);
+  EXPECT_DOUBLE_EQ(fitted.centroid.y, principal.centroid.y);
+  const double cu = 0.5 * (fitted.lo_u + fitted.hi_u), cv = 0.5 * (fitted.lo_v + fitted.hi_v);
+  const double c = std::cos(fitted.yaw), s = std::sin(fitted.yaw);
+  EXPECT_NEAR(fitted.centroid.x + c * cu - s * cv, 10.0, 1e-9);
+  EXPECT_NEAR(fitted.centroid.y + s * cu + c * cv, 5.0, 1e-9);
+  // The tracker counts the measurements whose box turned.
+  Tracker tracker(p);
+  const std::vector<float> xy = flatten(rearAndSide());
+  tracker.update(0.0, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, nullptr);
+  EXPECT_EQ(tracker.counts().box_fit, 1u);
+}
+
+TEST(Tracker, BoxFitLeavesAPedestrianAndAClusterWhoseAxesAreItsBox)
+{
+  TrackerParams p;
+  TrackerParams off = p;
+  off.box_fit = false;
+  auto same = [](const Measurement& a, const Measurement& b) {
+    return a.yaw == b.yaw && a.length == b.length && a.width == b.width && a.lo_u == b.lo_u && a.hi_v == b.hi_v &&
+           a.covariance == b.covariance && !a.fitted && !b.fitted;
+  };
+  // A 0.6 × 0.5 m L: shorter than box_fit_min_length along its principal axis, it keeps them, bit for bit.
+  EXPECT_TRUE(same(onlyCluster(rearAndSide(0.6, 0.5), p), onlyCluster(rearAndSide(0.6, 0.5), off)));
+  TrackerParams shorter = p;
+  shorter.box_fit_min_length = 0.5;
+  EXPECT_TRUE(onlyCluster(rearAndSide(0.6, 0.5), shorter).fitted) << "and is fitted once the limit is below it";
+  // A straight side: its principal axis is its rectangle's, within a step.
+  const Measurement side = onlyCluster(rearAndSide(kVehicleLength, 0.0), p);
+  EXPECT_FALSE(side.fitted);
+  EXPECT_NEAR(side.yaw, kVehicleYaw, 1e-9);
+  EXPECT_NEAR(side.length, kVehicleLength, 1e-9);
+}
+
+TEST(Tracker, BoxFitParametersAreValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_box_fit_step", [](TrackerParams& p) { p.box_fit_step = 0.0; } },
+      { "tracker_box_fit_step", [](TrackerParams& p) { p.box_fit_step = 46.0; } },
+      { "tracker_box_fit_step", [](TrackerParams& p) { p.box_fit_step = std::nan(""); } },
+      { "tracker_box_fit_closeness", [](TrackerParams& p) { p.box_fit_closeness = 0.0; } },
+      { "tracker_box_fit_closeness", [](TrackerParams& p) { p.box_fit_closeness = 1.5; } },
+      { "tracker_box_fit_min_length", [](TrackerParams& p) { p.box_fit_min_length = -0.1; } },
+      { "tracker_box_fit_min_length", [](TrackerParams& p) { p.box_fit_min_length = 19.0; } },
+      { "tracker_box_fit_min_length", [](TrackerParams& p) { p.box_fit_min_length = std::nan(""); } } });
+}
+
+namespace {
+
+constexpr double kBusLength = 12.0, kBusWidth = 2.5;
+constexpr double kBusSpeed = 6.6, kBusBraking = 1.5;  // m/s, m/s²
+
+/// A 12 × 2.5 m bus driving along −x at 6.6 m/s for ten scans, then braking at 1.5 m/s² over @p braking scans, seen
+/// whole from behind (the sensor 20 m beyond its rear), each cluster with clusterReturns()' σ; its rear has free space
+/// beyond it when @p rear_open. The tracker after the last scan; the bus's speed then in @p speed.
+Tracker busThatBrakes(const TrackerParams& params, int braking, bool rear_open, double& speed)
+{
+  Tracker tracker(params);
+  double front = 40.0;
+  speed = kBusSpeed;
+  for (int k = 0; k < 10 + braking; ++k)
+  {
+    if (k > 0)
+    {
+      const double v0 = speed;
+      if (k >= 10) speed -= kBusBraking * 0.1;
+      front -= 0.05 * (v0 + speed);
+    }
+    Measurement m = at(front + 0.5 * kBusLength, 2.4);
+    m.length = kBusLength;
+    m.width = kBusWidth;
+    m.lo_u = -0.5 * kBusLength;
+    m.hi_u = 0.5 * kBusLength;
+    m.lo_v = -0.5 * kBusWidth;
+    m.hi_v = 0.5 * kBusWidth;
+    const double su = params.measurement_sigma + params.extent_sigma * kBusLength;
+    const double sv = params.measurement_sigma + params.extent_sigma * kBusWidth;
+    m.covariance = Eigen::Vector2d(su * su, sv * sv).asDiagonal();
+    m.has_sensor = true;
+    m.sensor = Point2{ front + kBusLength + 20.0, 2.4 };
+    m.ends_seen = true;
+    m.open = rear_open ? Measurement::kHighU : 0;
+    tracker.update(0.1 * k, { m });
+  }
+  return tracker;
+}
+
+}  // namespace
+
+TEST(Tracker, OpenAnchorFollowsALongVehicleThatBrakes)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.open_anchor);
+  p.free_space_check = false;  // no ScanGrid here: the speed alone decides
+  TrackerParams off = p;
+  off.open_anchor = false;
+  double speed = 0.0;
+  const Tracker with = busThatBrakes(p, 20, true, speed);
+  const Tracker without = busThatBrakes(off, 20, true, speed);
+  ASSERT_EQ(with.tracks().size(), 1u);
+  ASSERT_EQ(without.tracks().size(), 1u);
+  ASSERT_NEAR(speed, kBusSpeed - 2.0 * kBusBraking, 1e-9);
+  const double lag_with = std::abs(with.tracks()[0].x(2)) - speed;
+  const double lag_without = std::abs(without.tracks()[0].x(2)) - speed;
+  EXPECT_GT(lag_without, 1.0) << "a 1.35 m σ along the bus keeps the constant-velocity filter's gain low";
+  EXPECT_LT(std::abs(lag_with), 0.5 * lag_without);
+  EXPECT_EQ(with.counts().open_anchor, 29u) << "every association after the first";
+  EXPECT_EQ(without.counts().open_anchor, 0u);
+}
+
+TEST(Tracker, OpenAnchorLeavesAClusterWhoseAnchoringEndIsNotOpen)
+{
+  TrackerParams p;
+  p.free_space_check = false;
+  TrackerParams off = p;
+  off.open_anchor = false;
+  double speed = 0.0;
+  const Tracker with = busThatBrakes(p, 20, false, speed);
+  const Tracker without = busThatBrakes(off, 20, false, speed);
+  ASSERT_EQ(with.tracks().size(), 1u);
+  ASSERT_EQ(without.tracks().size(), 1u);
+  EXPECT_EQ(with.tracks()[0].x, without.tracks()[0].x) << "bit for bit as without the step";
+  EXPECT_EQ(with.tracks()[0].P, without.tracks()[0].P);
+  EXPECT_EQ(with.counts().open_anchor, 0u);
 }

@@ -216,6 +216,23 @@ struct TrackerParams
   /// the usual σ (its velocity is known; measured, the larger σ made a turning van lag).
   bool hidden_ends = true;
   double hidden_ends_sigma = 5.0;  ///< m in (0, 100]
+  /// Step "box fit": a cluster's axes are those of the rectangle that fits its returns best, not its principal axes.
+  /// A vehicle seen on its rear and one side gives an L of returns whose principal axes lie between the two faces:
+  /// its box was askew by up to 45°, grew as more of the side came into view, and the point its track follows slid
+  /// across the vehicle. Rectangles are tried every box_fit_step degrees in [0°, 90°) and scored by the closeness
+  /// criterion of L-shape fitting (Zhang et al. 2017): each return adds 1 / max(d, box_fit_closeness), d its distance
+  /// to the rectangle's nearest edge. A cluster whose principal extent is shorter than box_fit_min_length keeps its
+  /// principal axes: a pedestrian's returns have no edges to fit.
+  bool box_fit = true;
+  double box_fit_step = 3.0;          ///< deg in [0.1, 45]
+  double box_fit_closeness = 0.05;    ///< m in (0, 1]: a return this near an edge scores as if on it
+  double box_fit_min_length = 1.5;    ///< m in [0, max_object_length]
+  /// Step "open anchor" (with step open ends, which finds the open faces): a track follows the end of its cluster
+  /// nearest the sensor (referencePoint()). When that end along the cluster's major axis has free space seen beyond
+  /// it, it is the object's own end, placed as well as a compact cluster's centroid: the measurement's σ along that
+  /// axis is measurement_sigma, without the extent_sigma share of the cluster's length. That share kept the gain of
+  /// a long vehicle's track low, and its velocity lagged by up to 2 m/s as it braked.
+  bool open_anchor = true;
 
   /// @throws ParameterError naming the first parameter out of range.
   void validate() const;
@@ -298,6 +315,11 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_second_axes_growth", p.second_axes_growth, { "", "the second cluster must be longer than this many times the first (step second axes)" });
   get("tracker_hidden_ends", p.hidden_ends, { "", "step hidden ends: a cluster whose two ends along its major axis are hidden and neither open tells a track not yet moving nothing along that axis" });
   get("tracker_hidden_ends_sigma", p.hidden_ends_sigma, { "m", "standard deviation added along such a cluster's major axis (step hidden ends)" });
+  get("tracker_box_fit", p.box_fit, { "", "step box fit: a cluster's axes are those of the rectangle that fits its returns best (closeness criterion), not its principal axes" });
+  get("tracker_box_fit_step", p.box_fit_step, { "deg", "angle between two rectangles tried (step box fit)" });
+  get("tracker_box_fit_closeness", p.box_fit_closeness, { "m", "a return this near a rectangle's edge scores as if on it (step box fit)" });
+  get("tracker_box_fit_min_length", p.box_fit_min_length, { "m", "a cluster whose principal extent is shorter keeps its principal axes (step box fit)" });
+  get("tracker_open_anchor", p.open_anchor, { "", "step open anchor: a cluster whose anchoring end along its major axis is open is placed along that axis with measurement_sigma" });
   get("tracker_hidden_centre", p.hidden_centre, { "", "step hidden centre: a moving track seen end-on reports the box of step hidden length and its centre" });
 }
 
@@ -339,6 +361,7 @@ struct Measurement
   static constexpr std::uint8_t kLowU = 1, kHighU = 2, kLowV = 4, kHighV = 8;
   std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
   bool split = false;  ///< step background split: a piece of the returns off background of a cluster too large
+  bool fitted = false;  ///< step box fit: its axes are more than box_fit_step off its principal axes
 };
 
 /// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
@@ -467,6 +490,8 @@ struct TrackerCounts
   std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
   std::uint64_t second_axes = 0;  ///< new tracks whose box turned to their second cluster's axes (step second axes)
   std::uint64_t hidden_ends = 0;  ///< associations of a track not yet moving with a cluster whose ends are hidden (step hidden ends)
+  std::uint64_t box_fit = 0;      ///< measurements whose fitted axes are more than box_fit_step off their principal ones (step box fit)
+  std::uint64_t open_anchor = 0;  ///< associations with a cluster placed by its open anchoring end (step open anchor)
   std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
 };
 
