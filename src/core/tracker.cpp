@@ -49,6 +49,9 @@ bool hiddenEnds(const Track& t, const Measurement& m, const TrackerParams& p)
          !(m.open & kEnds);
 }
 
+/// Standard deviation of a cluster's centroid along an axis on which it extends @p extent m.
+double clusterSigma(const TrackerParams& p, double extent) { return p.measurement_sigma + p.extent_sigma * extent; }
+
 /// Step open anchor (TrackerParams::open_anchor): the end of @p m on which @p t's box is anchored along the cluster's
 /// major axis (viewAlong()) has free space beyond it.
 bool openAnchor(const Track& t, const Measurement& m, const TrackerParams& p)
@@ -69,7 +72,7 @@ Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, cons
   const double along = dl * dl + (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
   if (openAnchor(t, m, p))
   {
-    const double su = p.measurement_sigma, sv = p.measurement_sigma + p.extent_sigma * m.width;
+    const double su = p.measurement_sigma, sv = clusterSigma(p, m.width);
     return (su * su + along) * major * major.transpose() + (sv * sv + dw * dw) * minor * minor.transpose();
   }
   return m.covariance + along * major * major.transpose() + dw * dw * minor * minor.transpose();
@@ -358,8 +361,7 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     m.yaw = std::atan2(major.y(), major.x());
     m.points = static_cast<int>(idx.size());
     m.returns = idx;
-    const double su = p.measurement_sigma + p.extent_sigma * m.length;
-    const double sv = p.measurement_sigma + p.extent_sigma * m.width;
+    const double su = clusterSigma(p, m.length), sv = clusterSigma(p, m.width);
     Eigen::Matrix2d axes;
     axes << major, minor;
     m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
