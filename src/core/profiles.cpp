@@ -122,6 +122,9 @@ const std::vector<AddedStep>& addedSteps()
     { "open_anchor", "a cluster placed by its end nearest the sensor, with free space beyond it, has a compact cluster's sigma along its axis",
       [](const Profile& p) { return p.tracker.enabled && p.tracker.open_anchor; },
       [](Profile& p) { p.tracker.open_anchor = false; } },
+    { "common_turn", "the common motion may turn about the sensor (a drifting heading): static objects far away are no faster than near ones",
+      [](const Profile& p) { return p.tracker.enabled && p.tracker.common_turn; },
+      [](Profile& p) { p.tracker.common_turn = false; } },
   };
   return steps;
 }

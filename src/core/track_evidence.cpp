@@ -136,7 +136,7 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     c.motion = t.motion == TrackMotion::kMoving    ? CellClass::kMoving
                : t.motion == TrackMotion::kStopped ? CellClass::kStopped
                                                    : CellClass::kOccupied;
-    c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p, tracker.commonMotion()));
+    c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p, tracker.commonMotionAt(t.position())));
     c.take_n = c.motion == CellClass::kMoving && p.evidence_small_size > 0.0 &&
                t.extent_length <= p.evidence_small_size && t.extent_width <= p.evidence_small_size;
     c.take_specialised = c.take_n && p.evidence_small_specialised;

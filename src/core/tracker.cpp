@@ -33,6 +33,10 @@ constexpr double kMaxBoxFitStep = 45.0;  // deg: two rectangles, at 0° and 45°
 constexpr double kMaxBoxFitCloseness = 1.0;  // m: box_fit_closeness, beyond any object's edge
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
+constexpr double kMaxCommonTurnRate = 1.0;  // rad/s: common_motion_max_turn_rate, far beyond any drift
+constexpr int kCommonTurnIterations = 10;   // reweightings of step common turn's fit
+constexpr double kMinCommonSigma = 0.01;    // m/s: a track's σ(speed) in that fit is never below
+constexpr double kCommonTurnSolveTolerance = 1e-9;  // relative residual of its normal equations: above, singular
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
 const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
 
@@ -172,6 +176,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_common_motion_share", common_motion_share, kMinShare, 1.0);
   requireInRange("tracker_common_motion_sigmas", common_motion_sigmas, 0.0, 10.0);
   requireInRange("tracker_common_motion_max_speed", common_motion_max_speed, 0.0, max_speed);
+  requireInRange("tracker_common_motion_max_turn_rate", common_motion_max_turn_rate, 0.0, kMaxCommonTurnRate);
   requireInRange("tracker_across_min_hits", across_min_hits, 1, 100000);
   requireInRange("tracker_across_min_length", across_min_length, 0.0, max_object_length);
   requireInRange("tracker_across_max_width_share", across_max_width_share, kMinShare, 1.0);
@@ -569,6 +574,7 @@ void Tracker::reset()
   tracks_.clear();
   common_motion_ = Point2{ 0.0, 0.0 };
   has_common_motion_ = false;
+  common_turn_rate_ = 0.0;
 }
 
 void Tracker::predict(Track& t, double dt) const
@@ -649,13 +655,46 @@ bool Tracker::fastEnough(const Track& t, double sigmas) const
   return decisionSpeed(t) - sigmas * t.speedSigma() > params_.moving_speed;
 }
 
+Tracker::CommonFit Tracker::fitCommonTurn(Point2 start) const
+{
+  Eigen::Vector3d theta(start.x, start.y, 0.0);
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  auto residual = [&theta](const SeenVelocity& s) {
+    return Eigen::Vector2d(s.v.x() - theta(0) + theta(2) * s.r.y(), s.v.y() - theta(1) - theta(2) * s.r.x());
+  };
+  for (int iteration = 0; iteration < kCommonTurnIterations; ++iteration)
+  {
+    a.setZero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (const SeenVelocity& s : common_seen_)
+    {
+      const double z = residual(s).norm() / s.sigma, k = params_.common_motion_sigmas;
+      const double w = (z <= k ? 1.0 : k / z) / (s.sigma * s.sigma);
+      const Eigen::Vector3d jx(1.0, 0.0, -s.r.y()), jy(0.0, 1.0, s.r.x());
+      a += w * (jx * jx.transpose() + jy * jy.transpose());
+      b += w * (jx * s.v.x() + jy * s.v.y());
+    }
+    const Eigen::Vector3d next = a.ldlt().solve(b);
+    if (!next.allFinite() || !((a * next - b).norm() <= kCommonTurnSolveTolerance * (b.norm() + 1.0)))
+      return CommonFit{ Point2{ 0.0, 0.0 }, std::nan(""), 0.0, 0 };
+    theta = next;
+  }
+  const long agree = std::count_if(common_seen_.begin(), common_seen_.end(), [&](const SeenVelocity& s) {
+    return residual(s).norm() <= params_.common_motion_sigmas * s.sigma;
+  });
+  const double turn_variance = a.inverse()(2, 2);
+  return CommonFit{ Point2{ theta(0), theta(1) }, theta(2), std::sqrt(std::max(0.0, turn_variance)), agree };
+}
+
 void Tracker::findCommonMotion(double stamp)
 {
   common_motion_ = Point2{ 0.0, 0.0 };
   has_common_motion_ = false;
+  common_turn_rate_ = 0.0;
   if (!params_.common_motion) return;
   common_vx_.clear();
   common_vy_.clear();
+  common_seen_.clear();
   auto seen = [&](const Track& t) { return t.reported() && t.last_hit >= stamp && finite(t.x, t.P); };
   for (const Track& t : tracks_)
     if (seen(t))
@@ -669,15 +708,39 @@ void Tracker::findCommonMotion(double stamp)
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n / 2), v.end());
     return v[n / 2];
   };
-  const Point2 m{ median(common_vx_), median(common_vy_) };
-  if (!(std::hypot(m.x, m.y) <= params_.common_motion_max_speed)) return;
-  const auto agree = std::count_if(tracks_.begin(), tracks_.end(), [&](const Track& t) {
+  Point2 m{ median(common_vx_), median(common_vy_) };
+  auto agree = std::count_if(tracks_.begin(), tracks_.end(), [&](const Track& t) {
     return seen(t) && t.speedRelativeTo(m) <= params_.common_motion_sigmas * t.speedSigma();
   });
-  if (!(static_cast<double>(agree) > params_.common_motion_share * static_cast<double>(n))) return;
+  const auto sensor =
+      std::find_if(measurements_.begin(), measurements_.end(), [](const Measurement& x) { return x.has_sensor; });
+  if (params_.common_turn && sensor != measurements_.end())
+  {
+    common_centre_ = sensor->sensor;
+    for (const Track& t : tracks_)
+      if (seen(t))
+        common_seen_.push_back(SeenVelocity{ Eigen::Vector2d(t.x(0) - common_centre_.x, t.x(1) - common_centre_.y),
+                                             t.x.tail<2>(), std::max(t.speedSigma(), kMinCommonSigma) });
+    const CommonFit fit = fitCommonTurn(m);
+    if (std::abs(fit.turn_rate) <= params_.common_motion_max_turn_rate &&
+        std::abs(fit.turn_rate) > params_.common_motion_sigmas * fit.turn_sigma && fit.agree > agree &&
+        std::hypot(fit.v.x, fit.v.y) <= params_.common_motion_max_speed)
+    {
+      m = fit.v;
+      agree = fit.agree;
+      common_turn_rate_ = fit.turn_rate;
+    }
+  }
+  if (!(std::hypot(m.x, m.y) <= params_.common_motion_max_speed) ||
+      !(static_cast<double>(agree) > params_.common_motion_share * static_cast<double>(n)))
+  {
+    common_turn_rate_ = 0.0;
+    return;
+  }
   common_motion_ = m;
   has_common_motion_ = true;
   ++counts_.common_motion_scans;
+  if (common_turn_rate_ != 0.0) ++counts_.common_turn_scans;
 }
 
 void Tracker::decideMotion(Track& t, double stamp) const
@@ -719,7 +782,8 @@ bool Tracker::movesAcrossFace(const Track& t) const
   const Measurement& m = measurements_[t.measurement];
   if (m.length < params_.across_min_length || m.width > params_.across_max_width_share * m.length) return false;
   const Eigen::Vector2d across(-std::sin(m.yaw), std::cos(m.yaw));
-  const double speed = std::abs((t.x(2) - common_motion_.x) * across.x() + (t.x(3) - common_motion_.y) * across.y());
+  const Point2 common = commonMotionAt(t.position());
+  const double speed = std::abs((t.x(2) - common.x) * across.x() + (t.x(3) - common.y) * across.y());
   const double sigma = std::sqrt(std::max(0.0, across.dot(t.P.bottomRightCorner<2, 2>() * across)));
   return speed - params_.across_sigmas * sigma > params_.moving_speed;
 }
@@ -763,8 +827,9 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     {
       const Sighting& earliest = t.sightings.front();
       const double dt = stamp - earliest.stamp;
-      if (std::hypot(t.x(0) - earliest.position.x - common_motion_.x * dt,
-                     t.x(1) - earliest.position.y - common_motion_.y * dt) >= params_.walk_distance)
+      const Point2 common = commonMotionAt(t.position());
+      if (std::hypot(t.x(0) - earliest.position.x - common.x * dt, t.x(1) - earliest.position.y - common.y * dt) >=
+          params_.walk_distance)
       {
         t.motion_seen = true;
         ++counts_.walked;

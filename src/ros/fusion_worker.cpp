@@ -774,6 +774,12 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     else
       status.add("common motion (last scan) [m/s]", "none");
     status.add("scans with a common motion", c.common_motion_scans);
+    {
+      std::ostringstream w;
+      w << std::fixed << std::setprecision(2) << tracker_->commonTurnRate() * 180.0 / M_PI;
+      status.add("common motion's turn rate (last scan) [deg/s]", w.str());
+    }
+    status.add("scans whose common motion turns", c.common_turn_scans);
     status.add("tracks whose motion was seen across their face", c.across_face);
     status.add("tracks whose motion was seen by the distance they walked", c.walked);
     status.add("new tracks whose box took their second cluster's axes", c.second_axes);

@@ -1402,6 +1402,19 @@ std::vector<Measurement> driftScan(int k, double drift, double walker_speed)
   return out;
 }
 
+/// A tracker with @p on and one with @p off, each fed kDriftScans scans @p scan(k) 0.1 s apart.
+template <typename Scan>
+std::pair<Tracker, Tracker> runBoth(const TrackerParams& on, const TrackerParams& off, Scan scan)
+{
+  std::pair<Tracker, Tracker> both{ Tracker(on), Tracker(off) };
+  for (int k = 0; k < kDriftScans; ++k)
+  {
+    both.first.update(0.1 * k, scan(k));
+    both.second.update(0.1 * k, scan(k));
+  }
+  return both;
+}
+
 }  // namespace
 
 // Step common motion: a pose drifting at 1.2 m/s makes every static object's track move at 1.2 m/s. With the step,
@@ -1414,13 +1427,8 @@ TEST(Tracker, CommonMotionOfADriftingPoseIsNoMotion)
   ASSERT_LT(on.common_motion_min_tracks, kStaticObjects + 1);
   TrackerParams off = on;
   off.common_motion = false;
-  Tracker with(on), without(off);
   constexpr double kDrift = 1.2, kWalker = 1.5;
-  for (int k = 0; k < kDriftScans; ++k)
-  {
-    with.update(0.1 * k, driftScan(k, kDrift, kWalker));
-    without.update(0.1 * k, driftScan(k, kDrift, kWalker));
-  }
+  const auto [with, without] = runBoth(on, off, [&](int k) { return driftScan(k, kDrift, kWalker); });
   ASSERT_EQ(with.tracks().size(), static_cast<std::size_t>(kStaticObjects + 1));
   ASSERT_EQ(without.tracks().size(), with.tracks().size());
   ASSERT_TRUE(with.hasCommonMotion());
@@ -1497,7 +1505,112 @@ TEST(Tracker, CommonMotionParametersAreValidatedByName)
       { "tracker_common_motion_sigmas", [](TrackerParams& p) { p.common_motion_sigmas = -1.0; } },
       { "tracker_common_motion_sigmas", [](TrackerParams& p) { p.common_motion_sigmas = std::nan(""); } },
       { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = -0.1; } },
-      { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = 1e3; } } });
+      { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = 1e3; } },
+      { "tracker_common_motion_max_turn_rate", [](TrackerParams& p) { p.common_motion_max_turn_rate = -0.01; } },
+      { "tracker_common_motion_max_turn_rate", [](TrackerParams& p) { p.common_motion_max_turn_rate = 1.1; } },
+      { "tracker_common_motion_max_turn_rate",
+        [](TrackerParams& p) { p.common_motion_max_turn_rate = std::nan(""); } } });
+}
+
+namespace {
+
+constexpr double kTurnRate = 0.03;  // rad/s, below tracker_common_motion_max_turn_rate
+
+/// Scan @p k (0.1 s apart) seen from a sensor at rest at the origin through a heading that drifts at @p turn_rate:
+/// kStaticObjects static objects all round at 10 to 55 m and a walker at 1.5 m/s along −y, the whole scene turned by
+/// turn_rate · t about the sensor. @p sensor: the measurements know the sensor position.
+std::vector<Measurement> turnScan(int k, double turn_rate, bool sensor)
+{
+  const double t = 0.1 * k, c = std::cos(turn_rate * t), s = std::sin(turn_rate * t);
+  auto seen = [&](double x, double y) {
+    Measurement m = at(c * x - s * y, s * x + c * y);
+    m.has_sensor = sensor;
+    return m;
+  };
+  std::vector<Measurement> out;
+  for (int j = 0; j < kStaticObjects; ++j)
+  {
+    const double bearing = 2.0 * M_PI * j / kStaticObjects, range = 10.0 + 45.0 * (j % 4) / 3.0;
+    out.push_back(seen(range * std::cos(bearing), range * std::sin(bearing)));
+  }
+  out.push_back(seen(12.0, 6.0 - 1.5 * t));
+  return out;
+}
+
+}  // namespace
+
+// Step common turn: a heading drifting at 0.03 rad/s moves static objects at 0.3 to 1.65 m/s, each its own way, so
+// no one velocity is shared. With the step the common motion turns at that rate about the sensor and, relative to it,
+// no static object moves while the walker does; with the median alone the far ones are moving. The filter is the same.
+TEST(Tracker, CommonTurnOfADriftingHeadingIsNoMotion)
+{
+  TrackerParams on;
+  ASSERT_TRUE(on.common_turn);
+  ASSERT_LE(kTurnRate, on.common_motion_max_turn_rate);
+  TrackerParams off = on;
+  off.common_turn = false;
+  const auto [with, without] = runBoth(on, off, [](int k) { return turnScan(k, kTurnRate, true); });
+  ASSERT_EQ(with.tracks().size(), static_cast<std::size_t>(kStaticObjects + 1));
+  ASSERT_EQ(without.tracks().size(), with.tracks().size());
+  ASSERT_TRUE(with.hasCommonMotion());
+  EXPECT_NEAR(with.commonTurnRate(), kTurnRate, 0.1 * kTurnRate);
+  EXPECT_NEAR(std::hypot(with.commonMotion().x, with.commonMotion().y), 0.0, 0.1) << "the sensor is at rest";
+  EXPECT_EQ(without.commonTurnRate(), 0.0);
+  EXPECT_EQ(without.counts().common_turn_scans, 0u);
+  EXPECT_GT(with.counts().common_turn_scans, 0u);
+  EXPECT_LE(with.counts().common_turn_scans, with.counts().common_motion_scans);
+  int static_moving_without = 0;
+  for (std::size_t i = 0; i < with.tracks().size(); ++i)
+  {
+    const Track& a = with.tracks()[i];
+    const Track& b = without.tracks()[i];
+    ASSERT_EQ(a.id, b.id);
+    EXPECT_EQ(a.x, b.x) << "the filter is the same";
+    const bool walker = i + 1 == with.tracks().size();
+    EXPECT_EQ(a.motion == TrackMotion::kMoving, walker) << "track " << a.id;
+    EXPECT_NEAR(with.decisionSpeed(a), walker ? 1.5 : 0.0, 0.15) << "track " << a.id;
+    const Point2 field = with.commonMotionAt(a.position());
+    EXPECT_NEAR(field.x, with.commonMotion().x - with.commonTurnRate() * a.x(1), 1e-12);
+    EXPECT_NEAR(field.y, with.commonMotion().y + with.commonTurnRate() * a.x(0), 1e-12);
+    static_moving_without += !walker && b.motion == TrackMotion::kMoving;
+  }
+  EXPECT_GT(static_moving_without, 0) << "without the step the scene must show the cause";
+}
+
+// The common motion turns only when the turn is real and its centre is known: a drift without a turn keeps the
+// median (ω = 0, every decision the same as without the step), and so does a turning scene whose measurements do not
+// know the sensor; a turn faster than common_motion_max_turn_rate is not a drift.
+TEST(Tracker, CommonTurnNeedsAKnownSensorAndASignificantSlowTurn)
+{
+  struct Case
+  {
+    const char* what;
+    double turn_rate;
+    bool sensor;
+    double max_turn_rate;
+  };
+  for (const Case& c : { Case{ "no turn", 0.0, true, 0.05 }, Case{ "no sensor", kTurnRate, false, 0.05 },
+                         Case{ "too fast a turn", kTurnRate, true, 0.5 * kTurnRate } })
+  {
+    TrackerParams on;
+    on.common_motion_max_turn_rate = c.max_turn_rate;
+    TrackerParams off = on;
+    off.common_turn = false;
+    Tracker with(on), without(off);
+    for (int k = 0; k < kDriftScans; ++k)
+    {
+      with.update(0.1 * k, turnScan(k, c.turn_rate, c.sensor));
+      without.update(0.1 * k, turnScan(k, c.turn_rate, c.sensor));
+      ASSERT_EQ(with.commonTurnRate(), 0.0) << c.what << ", scan " << k;
+      ASSERT_EQ(with.hasCommonMotion(), without.hasCommonMotion()) << c.what << ", scan " << k;
+      ASSERT_EQ(with.commonMotion().x, without.commonMotion().x) << c.what << ", scan " << k;
+      ASSERT_EQ(with.commonMotion().y, without.commonMotion().y) << c.what << ", scan " << k;
+    }
+    EXPECT_EQ(with.counts().common_turn_scans, 0u) << c.what;
+    ASSERT_EQ(with.tracks().size(), without.tracks().size()) << c.what;
+    for (std::size_t i = 0; i < with.tracks().size(); ++i)
+      EXPECT_EQ(with.tracks()[i].motion, without.tracks()[i].motion) << c.what << ", track " << i;
+  }
 }
 
 namespace {

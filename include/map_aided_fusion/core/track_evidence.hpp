@@ -19,9 +19,9 @@
 namespace map_aided_fusion {
 namespace core {
 
-/// The probability, from the track's speed relative to @p common_motion (step common motion, Tracker::commonMotion())
-/// and its σ, that it moves faster than moving_speed (moving) or slower than stopped_speed (stopped); 0 for a track
-/// whose motion is not decided.
+/// The probability, from the track's speed relative to @p common_motion (step common motion: the common motion at the
+/// track, Tracker::commonMotionAt()) and its σ, that it moves faster than moving_speed (moving) or slower than
+/// stopped_speed (stopped); 0 for a track whose motion is not decided.
 double motionProbability(const Track& track, const TrackerParams& params, Point2 common_motion = Point2{ 0.0, 0.0 });
 
 /// objectBox() of the track @p t of @p tracker, with its last scan's measurements.

@@ -174,6 +174,16 @@ struct TrackerParams
   double common_motion_share = 0.5;      ///< in (0, 1]
   double common_motion_sigmas = 2.0;     ///< σ(speed) of a track from the median that still agrees with it
   double common_motion_max_speed = 2.0;  ///< m/s
+  /// Step "common turn" (with common_motion): a heading that drifts turns the whole static world about the sensor,
+  /// so its objects move at speeds that grow with their distance, and no one velocity is shared (KITTI 00's last
+  /// sweeps: 0.4 m/s ahead, 1.6 m/s 40 m behind). The common motion is then a rigid motion about the sensor,
+  /// v(p) = v₀ + ω × (p − sensor), fitted to the velocities of the tracks seen in the scan by least squares weighted
+  /// by 1/σ(speed)², from the median with ω = 0, Huber-weighted beyond common_motion_sigmas σ. It replaces the median
+  /// when more of those tracks agree with it, ω is more than common_motion_sigmas of its standard error from 0 and at
+  /// most common_motion_max_turn_rate, and |v₀| is at most common_motion_max_speed. Needs the sensor position
+  /// (Measurement::has_sensor).
+  bool common_turn = true;
+  double common_motion_max_turn_rate = 0.05;  ///< rad/s in [0, 1]: a faster turn is not a drift
   /// Step "movers without a map": without a prior the grid never tells C and N from S and V (the scan's O is
   /// {C, N, S, V}), so the cells of a moving track's returns, and the box cells of a small mover (step small movers),
   /// also move to V the sets holding C or N. With a prior, C and N are the map's and the counter's and stay.
@@ -299,6 +309,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_common_motion_share", p.common_motion_share, { "", "share of those tracks that must agree with the median velocity" });
   get("tracker_common_motion_sigmas", p.common_motion_sigmas, { "", "a track agrees with the median when within this many σ(speed) of it" });
   get("tracker_common_motion_max_speed", p.common_motion_max_speed, { "m/s", "a faster median is traffic, not a drift: no common motion" });
+  get("tracker_common_turn", p.common_turn, { "", "step common turn: the common motion may turn about the sensor (a drifting heading)" });
+  get("tracker_common_motion_max_turn_rate", p.common_motion_max_turn_rate, { "rad/s", "a faster common turn is not a drift: the median stays" });
   get("tracker_evidence_small_specialised", p.evidence_small_specialised, { "", "step small specialised: a small mover's cells also move their mass on {N}, {S}, {N, S} to V (the counter's specialisation of a walker's pavement cells)" });
   get("tracker_evidence_without_map", p.evidence_without_map, { "", "step movers without a map: without a prior a moving track's return cells (and a small mover's box) also move the sets holding C or N to V" });
   get("tracker_across_face", p.across_face, { "", "step across its face: a track moving across its cluster's face (a car seen end-on) has shown its motion as the free-space check would" });
@@ -485,6 +497,7 @@ struct TrackerCounts
   std::uint64_t fragments = 0;          ///< clusters that started no track: fragments of a moving track (step fragments)
   std::uint64_t duplicates = 0;         ///< moving tracks deleted as duplicates of another (step duplicates)
   std::uint64_t common_motion_scans = 0;  ///< scans with a common motion (step common motion)
+  std::uint64_t common_turn_scans = 0;    ///< scans whose common motion turns (step common turn)
   std::uint64_t across_face = 0;  ///< tracks whose motion was seen across their face (step across its face)
   std::uint64_t walked = 0;       ///< tracks whose motion was seen by the distance they walked (step walked)
   std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
@@ -564,11 +577,19 @@ public:
   const std::vector<Point2>& points() const { return map_points_; }
   const TrackerCounts& counts() const { return counts_; }
   const TrackerParams& params() const { return params_; }
-  /// Step common motion: the last scan's common motion (m/s, map frame), (0, 0) when it had none.
+  /// Step common motion: the last scan's common motion (m/s, map frame) at the sensor, (0, 0) when it had none.
   Point2 commonMotion() const { return common_motion_; }
   bool hasCommonMotion() const { return has_common_motion_; }
-  /// The speed the motion decision takes: relative to the common motion.
-  double decisionSpeed(const Track& t) const { return t.speedRelativeTo(common_motion_); }
+  /// Step common turn: the last scan's common motion's turn rate (rad/s, counter-clockwise), 0 when it does not turn.
+  double commonTurnRate() const { return common_turn_rate_; }
+  /// The last scan's common motion at @p p (map frame): commonMotion() + ω × (p − sensor).
+  Point2 commonMotionAt(Point2 p) const
+  {
+    return Point2{ common_motion_.x - common_turn_rate_ * (p.y - common_centre_.y),
+                   common_motion_.y + common_turn_rate_ * (p.x - common_centre_.x) };
+  }
+  /// The speed the motion decision takes: relative to the common motion at the track.
+  double decisionSpeed(const Track& t) const { return t.speedRelativeTo(commonMotionAt(t.position())); }
   /// Drops every track (ids keep counting up).
   void reset();
 
@@ -600,9 +621,27 @@ private:
   std::vector<std::uint8_t> map_flags_;
   std::deque<SeenFree> seen_free_;  ///< the free space of the scans of the last free_space_time, oldest first
   bool free_now_ = false;           ///< seen_free_ holds this scan's (the check runs)
-  Point2 common_motion_;            ///< step common motion, m/s; (0, 0) when none
+  Point2 common_motion_;            ///< step common motion, m/s at common_centre_; (0, 0) when none
   bool has_common_motion_ = false;
+  double common_turn_rate_ = 0.0;   ///< step common turn, rad/s; 0 when none
+  Point2 common_centre_;            ///< the sensor position the common motion turns about
   std::vector<double> common_vx_, common_vy_;  ///< its buffers
+  /// Step common turn: a seen track's position relative to the sensor, velocity and σ(speed).
+  struct SeenVelocity
+  {
+    Eigen::Vector2d r, v;
+    double sigma;
+  };
+  std::vector<SeenVelocity> common_seen_;
+  /// Step common turn: fits the turning common motion to common_seen_ from @p start (v₀ at the sensor, ω = 0) and
+  /// returns v₀, ω, σ(ω) and how many tracks agree with it; ω is NaN when the fit is singular.
+  struct CommonFit
+  {
+    Point2 v;
+    double turn_rate, turn_sigma;
+    long agree;
+  };
+  CommonFit fitCommonTurn(Point2 start) const;
   TrackerCounts counts_;
   std::uint32_t next_id_ = 1;
   double last_stamp_ = -1.0;
