@@ -28,6 +28,8 @@ constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMaxHiddenEndsSigma = 100.0;  // m: hidden_ends_sigma, far beyond any object
 constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): step second axes leaves a box this near the cluster's axes
+constexpr double kLongBoxMaxWidthShare = 0.5;  // step long box: a cluster at most this wide for its length has an axis
+constexpr double kMaxLongBoxMinLength = 100.0;  // m: long_box_min_length, beyond any vehicle
 constexpr double kMinBoxFitStep = 0.1;   // deg: box_fit_step, 900 rectangles a cluster
 constexpr double kMaxBoxFitStep = 45.0;  // deg: two rectangles, at 0° and 45°
 constexpr double kMaxBoxFitCloseness = 1.0;  // m: box_fit_closeness, beyond any object's edge
@@ -176,6 +178,7 @@ void TrackerParams::validate() const
   requireInRange("tracker_common_motion_share", common_motion_share, kMinShare, 1.0);
   requireInRange("tracker_common_motion_sigmas", common_motion_sigmas, 0.0, 10.0);
   requireInRange("tracker_common_motion_max_speed", common_motion_max_speed, 0.0, max_speed);
+  requireInRange("tracker_long_box_min_length", long_box_min_length, 0.0, kMaxLongBoxMinLength);
   requireInRange("tracker_common_motion_max_turn_rate", common_motion_max_turn_rate, 0.0, kMaxCommonTurnRate);
   requireInRange("tracker_across_min_hits", across_min_hits, 1, 100000);
   requireInRange("tracker_across_min_length", across_min_length, 0.0, max_object_length);
@@ -591,8 +594,25 @@ void Tracker::predict(Track& t, double dt) const
   t.P = f * t.P * f.transpose() + qm;
 }
 
-void Tracker::correct(Track& t, const Measurement& m, double stamp) const
+namespace {
+
+/// Steps heading box and long box: the box of @p t turns to the axes at @p yaw, its extents and its middle (the point
+/// the track follows) taken from the cluster @p m along them.
+void turnBox(Track& t, const Measurement& m, double yaw)
 {
+  t.extent_yaw = yaw;
+  const Eigen::Vector2d tu(std::cos(yaw), std::sin(yaw)), tv(-tu.y(), tu.x());
+  const AxisView a = viewAlong(m, tu), b = viewAlong(m, tv);
+  t.extent_length = a.hi - a.lo;
+  t.extent_width = b.hi - b.lo;
+  t.x.head<2>() = Eigen::Vector2d(m.centroid.x, m.centroid.y) + 0.5 * (a.lo + a.hi) * tu + 0.5 * (b.lo + b.hi) * tv;
+}
+
+}  // namespace
+
+bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
+{
+  bool long_box = false;
   const Eigen::Matrix2d r = measurementCovariance(t, m, params_);
   const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + r;
   const Eigen::Matrix<double, 4, 2> k = t.P.leftCols<2>() * s.inverse();
@@ -614,14 +634,17 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
   {
     const double heading = std::atan2(t.x(3), t.x(2));
     const double off = std::remainder(heading - t.extent_yaw, 0.5 * M_PI);
-    if (std::abs(off) > params_.heading_box_angle * M_PI / 180.0)
+    if (std::abs(off) > params_.heading_box_angle * M_PI / 180.0) turnBox(t, m, heading);
+  }
+  else if (params_.long_box && t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed &&
+           m.length >= params_.long_box_min_length && m.width <= kLongBoxMaxWidthShare * m.length)
+  {
+    const double heading = std::atan2(t.x(3), t.x(2));
+    if (std::abs(std::remainder(m.yaw - heading, M_PI)) <= params_.heading_box_angle * M_PI / 180.0 &&
+        std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) > kMinAxesTurn)
     {
-      t.extent_yaw = heading;
-      const Eigen::Vector2d tu(std::cos(heading), std::sin(heading)), tv(-tu.y(), tu.x());
-      const AxisView a = viewAlong(m, tu), b = viewAlong(m, tv);
-      t.extent_length = a.hi - a.lo;
-      t.extent_width = b.hi - b.lo;
-      t.x.head<2>() = Eigen::Vector2d(m.centroid.x, m.centroid.y) + 0.5 * (a.lo + a.hi) * tu + 0.5 * (b.lo + b.hi) * tv;
+      turnBox(t, m, m.yaw);
+      long_box = true;
     }
   }
   if (anchored(t, m))
@@ -648,6 +671,7 @@ void Tracker::correct(Track& t, const Measurement& m, double stamp) const
   t.last_hit = stamp;
   if (t.state == TrackState::kCoasting || (t.state == TrackState::kTentative && t.consecutive_hits >= params_.confirm_hits))
     t.state = TrackState::kConfirmed;
+  return long_box;
 }
 
 bool Tracker::fastEnough(const Track& t, double sigmas) const
@@ -1031,7 +1055,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
       if (hiddenEnds(t, measurements_[pairs[r]], params_)) ++counts_.hidden_ends;
       if (openAnchor(t, measurements_[pairs[r]], params_)) ++counts_.open_anchor;
-      correct(t, measurements_[pairs[r]], stamp);
+      if (correct(t, measurements_[pairs[r]], stamp)) ++counts_.long_box;
       used[pairs[r]] = 1;
       t.measurement = pairs[r];
     }

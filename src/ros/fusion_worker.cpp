@@ -783,6 +783,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("tracks whose motion was seen across their face", c.across_face);
     status.add("tracks whose motion was seen by the distance they walked", c.walked);
     status.add("new tracks whose box took their second cluster's axes", c.second_axes);
+    status.add("boxes turned to a long cluster's axis", c.long_box);
     status.add("associations with a cluster whose ends were hidden (track not yet moving)", c.hidden_ends);
     status.add("measurements whose fitted box turned off their principal axes", c.box_fit);
     status.add("associations with a cluster placed by its open end", c.open_anchor);

@@ -820,9 +820,47 @@ TEST(Tracker, HeadingBoxLeavesTheBoxOfALongObjectAlone)
 {
   TrackerParams on;
   Track van;
-  // A van (5 × 2 m), longer than heading_box_max_length: its box keeps the axes of its first cluster.
+  // A van (5 × 2 m), longer than heading_box_max_length and shorter than long_box_min_length: its box keeps the axes
+  // of its first cluster.
   driveAndTurn(on, 5.0, 2.0, 6.0, van);
   EXPECT_NEAR(std::remainder(van.extent_yaw, 0.5 * M_PI), 0.0, 0.05);
+}
+
+// Step long box: a bus (12 × 2.5 m) pulling out by 16° keeps the axes of its first cluster without the step, and its
+// box swells to hold the bus askew; with it the box turns to the bus's long cluster and keeps the bus's size.
+TEST(Tracker, LongBoxTurnsTheBoxOfABusThatTurns)
+{
+  TrackerParams on, off;
+  ASSERT_TRUE(on.long_box);
+  ASSERT_LT(on.long_box_min_length, 12.0);
+  ASSERT_GT(12.0, on.heading_box_max_length) << "the bus is not step heading box's";
+  off.long_box = false;
+  Track with, without;
+  constexpr double kTurn = 16.0;
+  const std::vector<std::uint32_t> ids = driveAndTurn(on, 12.0, 2.5, kTurn / 8.0, with);
+  driveAndTurn(off, 12.0, 2.5, kTurn / 8.0, without);
+  ASSERT_FALSE(ids.empty());
+  for (const std::uint32_t id : ids) EXPECT_EQ(id, ids.front()) << "one id all along";
+  EXPECT_EQ(with.motion, TrackMotion::kMoving);
+  // Its axes within 0.1 rad (the smallest turn) of the bus's, so its width at most that of the bus seen that much
+  // askew (plus the outline's 0.1 m spacing).
+  constexpr double kSmallestTurn = 0.1;
+  EXPECT_LE(std::abs(std::remainder(with.extent_yaw - kTurn * M_PI / 180.0, 0.5 * M_PI)), kSmallestTurn + 1e-9);
+  EXPECT_LE(std::min(with.extent_length, with.extent_width),
+            2.5 * std::cos(kSmallestTurn) + 12.0 * std::sin(kSmallestTurn) + 0.1);
+  EXPECT_NEAR(std::max(with.extent_length, with.extent_width), 12.0, 0.5);
+  // Without the step: the first axes, and a box as wide as the bus seen 16° askew.
+  const double a = kTurn * M_PI / 180.0, askew_width = 2.5 * std::cos(a) + 12.0 * std::sin(a);
+  EXPECT_NEAR(std::remainder(without.extent_yaw, 0.5 * M_PI), 0.0, 0.05);
+  EXPECT_GT(std::min(without.extent_length, without.extent_width), askew_width - 0.2);
+}
+
+TEST(Tracker, LongBoxMinLengthIsValidatedByName)
+{
+  expectRefusedByName({
+      { "tracker_long_box_min_length", [](TrackerParams& p) { p.long_box_min_length = -1.0; } },
+      { "tracker_long_box_min_length", [](TrackerParams& p) { p.long_box_min_length = 101.0; } },
+      { "tracker_long_box_min_length", [](TrackerParams& p) { p.long_box_min_length = std::nan(""); } } });
 }
 
 TEST(Tracker, HeadingBoxParametersAreValidatedByName)

@@ -114,6 +114,14 @@ struct TrackerParams
   bool heading_box = true;
   double heading_box_angle = 20.0;      ///< deg in [0, 45]: the box turns when its axes are this far from the heading
   double heading_box_max_length = 2.5;  ///< m: only boxes no longer than this turn (cyclists, pedestrians)
+  /// Step "long box": a long vehicle keeps the axes of its first cluster too (the front face of a bus seen from 70 m),
+  /// and when it turns (a bus pulling in to a stop at 16°) its box, grown to hold every cluster in those axes, swells
+  /// (6 × 12 m for a 2.5 × 12 m bus), and the point the track follows slides across it. A moving track whose cluster
+  /// is at least long_box_min_length long, at most half as wide, and whose major axis lies within heading_box_angle of
+  /// the track's heading, turns its box to that axis once the box is more than 6° from it, extents and middle from
+  /// that cluster. Shorter clusters (a car's L seen end-on) do not give an axis this reliable.
+  bool long_box = true;
+  double long_box_min_length = 6.0;  ///< m in [0, 100]: shortest cluster whose axis the box takes
   /// Step "track evidence" (core/track_evidence.hpp): the weight w of a track's motion in its cells' masses,
   /// β = w · P(motion); 0: off.
   double evidence_weight = 0.8;
@@ -293,6 +301,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_heading_box", p.heading_box, { "", "step heading box: a short moving track's box turns to its heading once askew" });
   get("tracker_heading_box_angle", p.heading_box_angle, { "deg", "the box turns when its axes are this far from the track's heading" });
   get("tracker_heading_box_max_length", p.heading_box_max_length, { "m", "only boxes no longer than this turn to the heading" });
+  get("tracker_long_box", p.long_box, { "", "step long box: a long moving track's box turns to its long cluster's axis" });
+  get("tracker_long_box_min_length", p.long_box_min_length, { "m", "shortest cluster whose axis a moving track's box takes (step long box)" });
   get("tracker_evidence_weight", p.evidence_weight, { "", "step track evidence: weight w of a track's motion in its cells (β = w·P(motion)); 0: off" });
   get("tracker_evidence_hidden_length", p.evidence_hidden_length, { "m", "step hidden length: a moving track seen end-on has its box extended away from the sensor to this length; 0: off" });
   get("tracker_hidden_length", p.hidden_length, { "", "step hidden length on (with tracker_evidence_hidden_length > 0)" });
@@ -502,6 +512,7 @@ struct TrackerCounts
   std::uint64_t walked = 0;       ///< tracks whose motion was seen by the distance they walked (step walked)
   std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
   std::uint64_t second_axes = 0;  ///< new tracks whose box turned to their second cluster's axes (step second axes)
+  std::uint64_t long_box = 0;     ///< boxes turned to a long cluster's axis (step long box)
   std::uint64_t hidden_ends = 0;  ///< associations of a track not yet moving with a cluster whose ends are hidden (step hidden ends)
   std::uint64_t box_fit = 0;      ///< measurements whose fitted axes are more than box_fit_step off their principal ones (step box fit)
   std::uint64_t open_anchor = 0;  ///< associations with a cluster placed by its open anchoring end (step open anchor)
@@ -595,7 +606,8 @@ public:
 
 private:
   void predict(Track& t, double dt) const;
-  void correct(Track& t, const Measurement& m, double stamp) const;
+  /// Kalman update of @p t with @p m and the box's bookkeeping; true when step long box turned the box.
+  bool correct(Track& t, const Measurement& m, double stamp) const;
   void decideMotion(Track& t, double stamp) const;
   /// Step free-space check: records @p t's sighting of this scan and tells whether free space shows its motion.
   void seeFreeSpace(Track& t, double stamp);
