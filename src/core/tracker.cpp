@@ -27,7 +27,7 @@ constexpr double kOccluderGap = 1.0;   // m: an occluder lies at least this much
 constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMaxHiddenEndsSigma = 100.0;  // m: hidden_ends_sigma, far beyond any object
-constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): step second axes leaves a box this near the cluster's axes
+constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): axes this near are the same (steps second axes, long box, far growth)
 constexpr double kLongBoxMaxWidthShare = 0.5;  // step long box: a cluster at most this wide for its length has an axis
 constexpr double kMaxLongBoxMinLength = 100.0;  // m: long_box_min_length, beyond any vehicle
 constexpr double kMinBoxFitStep = 0.1;   // deg: box_fit_step, 900 rectangles a cluster
@@ -67,15 +67,23 @@ bool openAnchor(const Track& t, const Measurement& m, const TrackerParams& p)
   return (m.open & (a.anchor_lo ? Measurement::kLowU : Measurement::kHighU)) != 0;
 }
 
+/// Step far growth (TrackerParams::far_growth): @p m is placed by its open anchoring end (openAnchor()) and its major
+/// axis is one of @p t's box axes.
+bool farGrowth(const Track& t, const Measurement& m, const TrackerParams& p)
+{
+  return p.far_growth && openAnchor(t, m, p) && std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) <= kMinAxesTurn;
+}
+
 /// The measurement's covariance, grown by the change of the cluster's extent since the track's last cluster: a
 /// partially seen object's centroid is off by up to half the part not seen; with step hidden ends, by
 /// hidden_ends_sigma along the major axis of a cluster whose ends are hidden. With step open anchor, a cluster placed
-/// by its open end has measurement_sigma along its major axis instead of its own σ.
+/// by its open end has measurement_sigma along its major axis instead of its own σ; with step far growth, not grown.
 Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, const TrackerParams& p)
 {
   const double dl = 0.5 * std::abs(m.length - t.length), dw = 0.5 * std::abs(m.width - t.width);
   const Eigen::Vector2d major(std::cos(m.yaw), std::sin(m.yaw)), minor(-major.y(), major.x());
-  const double along = dl * dl + (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
+  const double along = (farGrowth(t, m, p) ? 0.0 : dl * dl) +
+                       (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
   if (openAnchor(t, m, p))
   {
     const double su = p.measurement_sigma, sv = clusterSigma(p, m.width);
@@ -1055,6 +1063,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
       if (hiddenEnds(t, measurements_[pairs[r]], params_)) ++counts_.hidden_ends;
       if (openAnchor(t, measurements_[pairs[r]], params_)) ++counts_.open_anchor;
+      if (farGrowth(t, measurements_[pairs[r]], params_)) ++counts_.far_growth;
       if (correct(t, measurements_[pairs[r]], stamp)) ++counts_.long_box;
       used[pairs[r]] = 1;
       t.measurement = pairs[r];

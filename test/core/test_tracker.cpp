@@ -2202,6 +2202,25 @@ namespace {
 constexpr double kBusLength = 12.0, kBusWidth = 2.5;
 constexpr double kBusSpeed = 6.6, kBusBraking = 1.5;  // m/s, m/s²
 
+/// A cluster of @p length × @p width m about (x, y), its major axis along x, with clusterReturns()' σ; it knows the
+/// sensor and which of its ends step open ends saw (set them).
+Measurement boxCluster(double x, double y, double length, double width, const TrackerParams& params)
+{
+  Measurement m = at(x, y);
+  m.length = length;
+  m.width = width;
+  m.lo_u = -0.5 * length;
+  m.hi_u = 0.5 * length;
+  m.lo_v = -0.5 * width;
+  m.hi_v = 0.5 * width;
+  const double su = params.measurement_sigma + params.extent_sigma * length;
+  const double sv = params.measurement_sigma + params.extent_sigma * width;
+  m.covariance = Eigen::Vector2d(su * su, sv * sv).asDiagonal();
+  m.has_sensor = true;
+  m.ends_seen = true;
+  return m;
+}
+
 /// A 12 × 2.5 m bus driving along −x at 6.6 m/s for ten scans, then braking at 1.5 m/s² over @p braking scans, seen
 /// whole from behind (the sensor 20 m beyond its rear), each cluster with clusterReturns()' σ; its rear has free space
 /// beyond it when @p rear_open. The tracker after the last scan; the bus's speed then in @p speed.
@@ -2218,19 +2237,8 @@ Tracker busThatBrakes(const TrackerParams& params, int braking, bool rear_open, 
       if (k >= 10) speed -= kBusBraking * 0.1;
       front -= 0.05 * (v0 + speed);
     }
-    Measurement m = at(front + 0.5 * kBusLength, 2.4);
-    m.length = kBusLength;
-    m.width = kBusWidth;
-    m.lo_u = -0.5 * kBusLength;
-    m.hi_u = 0.5 * kBusLength;
-    m.lo_v = -0.5 * kBusWidth;
-    m.hi_v = 0.5 * kBusWidth;
-    const double su = params.measurement_sigma + params.extent_sigma * kBusLength;
-    const double sv = params.measurement_sigma + params.extent_sigma * kBusWidth;
-    m.covariance = Eigen::Vector2d(su * su, sv * sv).asDiagonal();
-    m.has_sensor = true;
+    Measurement m = boxCluster(front + 0.5 * kBusLength, 2.4, kBusLength, kBusWidth, params);
     m.sensor = Point2{ front + kBusLength + 20.0, 2.4 };
-    m.ends_seen = true;
     m.open = rear_open ? Measurement::kHighU : 0;
     tracker.update(0.1 * k, { m });
   }
@@ -2274,4 +2282,75 @@ TEST(Tracker, OpenAnchorLeavesAClusterWhoseAnchoringEndIsNotOpen)
   EXPECT_EQ(with.tracks()[0].x, without.tracks()[0].x) << "bit for bit as without the step";
   EXPECT_EQ(with.tracks()[0].P, without.tracks()[0].P);
   EXPECT_EQ(with.counts().open_anchor, 0u);
+}
+
+namespace {
+
+constexpr double kCarLength = 4.4, kCarSide = 0.3, kCarSpeed = 12.0;  // m, m, m/s
+constexpr double kOccluderEdge = 41.2;                                // m: x beyond which the car is hidden
+
+/// A 4.4 m car driving along −x at 12 m/s out from behind an occluder whose edge is at x = 41.2, seen from ahead (the
+/// sensor 30 m beyond its front) over @p scans scans: its front is open, its rear hidden until it is out, and its
+/// cluster (one side, 0.3 m wide) grows by 1.2 m a scan at its rear: 1.2, 2.4, 3.6, then 4.4 m. The cluster's axes
+/// are turned by @p turn from the x axis after the first scan.
+Tracker carComingOut(const TrackerParams& params, int scans, double turn = 0.0)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < scans; ++k)
+  {
+    const double front = 40.0 - kCarSpeed * 0.1 * k;
+    const double rear = std::min(front + kCarLength, kOccluderEdge), seen = rear - front;
+    Measurement m = boxCluster(0.5 * (front + rear), 2.0, seen, kCarSide, params);
+    m.yaw = k > 0 ? turn : 0.0;
+    m.sensor = Point2{ front - 30.0, 2.0 };
+    m.open = Measurement::kLowU;
+    m.occluded = rear < front + kCarLength ? Measurement::kHighU : 0;
+    tracker.update(0.1 * k, { m });
+  }
+  return tracker;
+}
+
+}  // namespace
+
+TEST(Tracker, FarGrowthFollowsACarComingOutFromBehindAnOccluder)
+{
+  TrackerParams p;
+  ASSERT_TRUE(p.open_anchor);
+  ASSERT_TRUE(p.far_growth);
+  ASSERT_EQ(p.confirm_hits, 3);
+  p.free_space_check = false;
+  TrackerParams off = p;
+  off.far_growth = false;
+  // Its velocity when it is confirmed, the first one reported.
+  const Tracker with = carComingOut(p, 3);
+  const Tracker without = carComingOut(off, 3);
+  ASSERT_EQ(with.tracks().size(), 1u);
+  ASSERT_EQ(without.tracks().size(), 1u);
+  const double error_with = std::abs(with.tracks()[0].x(2) + kCarSpeed);
+  const double error_without = std::abs(without.tracks()[0].x(2) + kCarSpeed);
+  EXPECT_GT(error_without, 2.0) << "half of each 1.2 m growth in the sigma keeps the velocity near its prior of 0";
+  EXPECT_LT(error_with, 0.5 * error_without);
+  EXPECT_EQ(with.counts().far_growth, 2u) << "every association after the first";
+  EXPECT_EQ(with.counts().open_anchor, 2u);
+  EXPECT_EQ(without.counts().far_growth, 0u);
+  TrackerParams no_anchor = p;
+  no_anchor.open_anchor = false;
+  EXPECT_EQ(carComingOut(no_anchor, 3).counts().far_growth, 0u) << "far growth is a part of step open anchor";
+}
+
+TEST(Tracker, FarGrowthLeavesAClusterTurnedOffTheBoxAxes)
+{
+  TrackerParams p;
+  p.free_space_check = false;
+  TrackerParams off = p;
+  off.far_growth = false;
+  const double turn = 0.2;  // rad: more than the 0.1 rad within which two axes are the same
+  const Tracker with = carComingOut(p, 4, turn);
+  const Tracker without = carComingOut(off, 4, turn);
+  ASSERT_EQ(with.tracks().size(), 1u);
+  ASSERT_EQ(without.tracks().size(), 1u);
+  EXPECT_EQ(with.tracks()[0].x, without.tracks()[0].x) << "bit for bit as without the step";
+  EXPECT_EQ(with.tracks()[0].P, without.tracks()[0].P);
+  EXPECT_EQ(with.counts().far_growth, 0u);
+  EXPECT_GT(with.counts().open_anchor, 0u) << "the open anchor itself still holds";
 }
