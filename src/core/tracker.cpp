@@ -637,19 +637,17 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   t.width = m.width;
   t.widest_length = std::max(t.widest_length, m.length);
   t.widest_width = std::max(t.widest_width, m.width);
-  if (params_.heading_box && t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed &&
-      std::max(t.extent_length, t.extent_width) <= params_.heading_box_max_length)
+  if (t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed)
   {
     const double heading = std::atan2(t.x(3), t.x(2));
-    const double off = std::remainder(heading - t.extent_yaw, 0.5 * M_PI);
-    if (std::abs(off) > params_.heading_box_angle * M_PI / 180.0) turnBox(t, m, heading);
-  }
-  else if (params_.long_box && t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed &&
-           m.length >= params_.long_box_min_length && m.width <= kLongBoxMaxWidthShare * m.length)
-  {
-    const double heading = std::atan2(t.x(3), t.x(2));
-    if (std::abs(std::remainder(m.yaw - heading, M_PI)) <= params_.heading_box_angle * M_PI / 180.0 &&
-        std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) > kMinAxesTurn)
+    const double max_off = params_.heading_box_angle * M_PI / 180.0;
+    if (params_.heading_box && std::max(t.extent_length, t.extent_width) <= params_.heading_box_max_length)
+    {
+      if (std::abs(std::remainder(heading - t.extent_yaw, 0.5 * M_PI)) > max_off) turnBox(t, m, heading);
+    }
+    else if (params_.long_box && m.length >= params_.long_box_min_length &&
+             m.width <= kLongBoxMaxWidthShare * m.length && std::abs(std::remainder(m.yaw - heading, M_PI)) <= max_off &&
+             std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) > kMinAxesTurn)
     {
       turnBox(t, m, m.yaw);
       long_box = true;

@@ -787,7 +787,7 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("associations with a cluster whose ends were hidden (track not yet moving)", c.hidden_ends);
     status.add("measurements whose fitted box turned off their principal axes", c.box_fit);
     status.add("associations with a cluster placed by its open end", c.open_anchor);
-    status.add("... of them whose growth at the other end left their sigma as it was", c.far_growth);
+    status.add("associations placed by an open end whose growth at the other end left their sigma", c.far_growth);
     status.add("measurements split off static background", c.split_measurements);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
   }

@@ -2245,6 +2245,30 @@ Tracker busThatBrakes(const TrackerParams& params, int braking, bool rear_open, 
   return tracker;
 }
 
+constexpr double kCarLength = 4.4, kCarSide = 0.3, kCarSpeed = 12.0;  // m, m, m/s
+constexpr double kOccluderEdge = 41.2;                                // m: x beyond which the car is hidden
+
+/// A 4.4 m car driving along −x at 12 m/s out from behind an occluder whose edge is at x = 41.2, seen from ahead (the
+/// sensor 30 m beyond its front) over @p scans scans: its front is open, its rear hidden until it is out, and its
+/// cluster (one side, 0.3 m wide) grows by 1.2 m a scan at its rear: 1.2, 2.4, 3.6, then 4.4 m. The cluster's axes
+/// are turned by @p turn from the x axis after the first scan.
+Tracker carComingOut(const TrackerParams& params, int scans, double turn = 0.0)
+{
+  Tracker tracker(params);
+  for (int k = 0; k < scans; ++k)
+  {
+    const double front = 40.0 - kCarSpeed * 0.1 * k;
+    const double rear = std::min(front + kCarLength, kOccluderEdge), seen = rear - front;
+    Measurement m = boxCluster(0.5 * (front + rear), 2.0, seen, kCarSide, params);
+    m.yaw = k > 0 ? turn : 0.0;
+    m.sensor = Point2{ front - 30.0, 2.0 };
+    m.open = Measurement::kLowU;
+    m.occluded = rear < front + kCarLength ? Measurement::kHighU : 0;
+    tracker.update(0.1 * k, { m });
+  }
+  return tracker;
+}
+
 }  // namespace
 
 TEST(Tracker, OpenAnchorFollowsALongVehicleThatBrakes)
@@ -2283,34 +2307,6 @@ TEST(Tracker, OpenAnchorLeavesAClusterWhoseAnchoringEndIsNotOpen)
   EXPECT_EQ(with.tracks()[0].P, without.tracks()[0].P);
   EXPECT_EQ(with.counts().open_anchor, 0u);
 }
-
-namespace {
-
-constexpr double kCarLength = 4.4, kCarSide = 0.3, kCarSpeed = 12.0;  // m, m, m/s
-constexpr double kOccluderEdge = 41.2;                                // m: x beyond which the car is hidden
-
-/// A 4.4 m car driving along −x at 12 m/s out from behind an occluder whose edge is at x = 41.2, seen from ahead (the
-/// sensor 30 m beyond its front) over @p scans scans: its front is open, its rear hidden until it is out, and its
-/// cluster (one side, 0.3 m wide) grows by 1.2 m a scan at its rear: 1.2, 2.4, 3.6, then 4.4 m. The cluster's axes
-/// are turned by @p turn from the x axis after the first scan.
-Tracker carComingOut(const TrackerParams& params, int scans, double turn = 0.0)
-{
-  Tracker tracker(params);
-  for (int k = 0; k < scans; ++k)
-  {
-    const double front = 40.0 - kCarSpeed * 0.1 * k;
-    const double rear = std::min(front + kCarLength, kOccluderEdge), seen = rear - front;
-    Measurement m = boxCluster(0.5 * (front + rear), 2.0, seen, kCarSide, params);
-    m.yaw = k > 0 ? turn : 0.0;
-    m.sensor = Point2{ front - 30.0, 2.0 };
-    m.open = Measurement::kLowU;
-    m.occluded = rear < front + kCarLength ? Measurement::kHighU : 0;
-    tracker.update(0.1 * k, { m });
-  }
-  return tracker;
-}
-
-}  // namespace
 
 TEST(Tracker, FarGrowthFollowsACarComingOutFromBehindAnOccluder)
 {
