@@ -15,7 +15,10 @@ END = "<!-- bench:end -->"
 
 DRIVE = "BM_MapGridUpdateDrive/n:{n}/threads:{t}/skip:{s}/iterations:200/real_time"
 
-# (benchmark, what it measures, reference benchmark or None[, counter shown after "what"]): the ratio is median /
+SHARES = ("skipped_share", "observed_share", "changing_share")
+FIXED_POINT = "BM_ScansToFixedPoint/history:{h}/iterations:1"
+
+# (benchmark, what it measures, reference benchmark or None[, counters shown after "what"]): the ratio is median /
 # median of the reference.
 ROWS = [
     ("BM_MapGridUpdate/n:200/threads:1/real_time", "the whole per-scan update, the paper's 100 m at 0.5 m (200 × 200)", None),
@@ -25,11 +28,15 @@ ROWS = [
     ("BM_MapGridUpdateReturns/n:800/threads:2/real_time", "the update with the scan's obstacle returns (the live default)", "BM_MapGridUpdate/n:800/threads:2/real_time"),
     ("BM_UpdateBaseline/n:800/threads:2/real_time", "the bytes the update cannot avoid, streamed once", "BM_MapGridUpdate/n:800/threads:2/real_time"),
     (DRIVE.format(n=800, t=1, s=0), "the update on a realistic drive (32-beam lidar through the simulated town at 8 m/s, prior, 200 sweeps from an empty grid), 800 × 800, `skip_unchanged` off", None),
-    (DRIVE.format(n=800, t=1, s=1), "the same with `skip_unchanged` (the default)", DRIVE.format(n=800, t=1, s=0), "skipped_share"),
+    (DRIVE.format(n=800, t=1, s=1), "the same with `skip_unchanged` (the default)", DRIVE.format(n=800, t=1, s=0), SHARES),
     (DRIVE.format(n=800, t=2, s=0), "the realistic drive, 2 threads, `skip_unchanged` off", None),
-    (DRIVE.format(n=800, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=800, t=2, s=0), "skipped_share"),
+    (DRIVE.format(n=800, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=800, t=2, s=0), SHARES),
     (DRIVE.format(n=200, t=2, s=0), "the realistic drive, 200 × 200 at 0.5 m, 2 threads, `skip_unchanged` off", None),
-    (DRIVE.format(n=200, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=200, t=2, s=0), "skipped_share"),
+    (DRIVE.format(n=200, t=2, s=1), "the same with `skip_unchanged`", DRIVE.format(n=200, t=2, s=0), SHARES),
+    (FIXED_POINT.format(h=0), "a cell seen free on a mapped road, then no longer observed: the scans the step still computes before it leaves the cell bit for bit (skip_unchanged then skips it); the time is that whole history on 16 × 16 cells", None, ("scans",)),
+    (FIXED_POINT.format(h=1), "the same for a cell seen occupied on a mapped road (a parked car that left)", None, ("scans",)),
+    (FIXED_POINT.format(h=2), "the same for a cell seen occupied on a mapped building", None, ("scans",)),
+    (FIXED_POINT.format(h=3), "the same for a cell seen free without a map", None, ("scans",)),
     ("BM_MapGridShift/threads:2/skip:0/real_time", "moving the 800 × 800 window by 25 columns and 3 rows (a recentring after 5 m): masses and ζ, 2 threads", "BM_MapGridUpdate/n:800/threads:2/real_time"),
     ("BM_MapGridShift/threads:2/skip:1/real_time", "the same with what `skip_unchanged` keeps (flags, the prior they hold for, BetP, decisions)", "BM_MapGridShift/threads:2/skip:0/real_time"),
     ("BM_FusionStep/n:800/threads:2/real_time", "the fused step alone (refine, prior, discounting, ⊛, counter, BetP)", "BM_MapGridUpdate/n:800/threads:2/real_time"),
@@ -79,16 +86,42 @@ def table(data):
     for name, what, ref, *counter in ROWS:
         if name not in m:
             continue
-        if counter and counter[0] in runs[name]:
-            what += f"; {counter[0].replace('_', ' ')} {runs[name][counter[0]]:.2f}"
+        shown = [f"{c.replace('_', ' ')} {number(runs[name][c])}" for c in (counter[0] if counter else ()) if c in runs[name]]
+        if shown:
+            what += "; " + ", ".join(shown)
         ratio = f"{m[name] / m[ref]:.2f}" if ref and ref in m else ""
         lines.append(f"| `{short(name)}` | {what} | {m[name]:.3f} | {ratio} | "
                      f"{'`' + short(ref) + '`' if ref and ref in m else ''} |")
+    bound = skip_bound(runs)
+    if bound:
+        lines += ["", bound]
     return "\n".join(lines) + "\n"
 
 
+def skip_bound(runs):
+    """What the realistic drive would still take were the cells skip_unchanged skips free: the stages of the drive
+    without it, its fused step scaled by the share of cells the drive with it computes."""
+    parts = []
+    for n in (800, 200):
+        off, on = runs.get(DRIVE.format(n=n, t=2, s=0)), runs.get(DRIVE.format(n=n, t=2, s=1))
+        stages = ("shift_ms", "project_ms", "prior_ms", "fusion_ms")
+        if not off or not on or "skipped_share" not in on or any(k not in off for k in stages):
+            return None
+        computed = 1.0 - on["skipped_share"]
+        ms = off["shift_ms"] + off["project_ms"] + off["prior_ms"] + off["fusion_ms"] * computed
+        parts.append(f"{ms:.2f} ms at {n} × {n} (computing {computed:.2f} of the cells)")
+    return ("Were the cells `skip_unchanged` skips free, the realistic drive with 2 threads would still take "
+            + " and ".join(parts) + ": the stages of the drive without it, its fused step scaled by the share of "
+            "cells the drive with it computes.")
+
+
+def number(value):
+    """A counter: a whole count as such, a share with two decimals."""
+    return f"{value:.0f}" if value > 1.0 and value == round(value) else f"{value:.2f}"
+
+
 def short(name):
-    return name.replace("/real_time", "").replace("/iterations:200", "")
+    return re.sub(r"/iterations:\d+", "", name.replace("/real_time", ""))
 
 
 def cpu_model():

@@ -189,6 +189,7 @@ void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, co
     sum.sum_conflict_other += s.sum_conflict_other;
     sum.num_cells += s.num_cells;
     sum.num_skipped += s.num_skipped;
+    sum.num_observed += s.num_observed;
   };
   auto chunk = [&](std::size_t c) {
     const std::size_t begin = c * kFusionChunkCells, end = std::min(in.cells, begin + kFusionChunkCells);
@@ -227,6 +228,7 @@ void fuse(MapMassGrid& map, const ScanMassGrid* scan, const ScanCells* cells, co
     total.sum_conflict_other += p.sum_conflict_other;
     total.num_cells += p.num_cells;
     total.num_skipped += p.num_skipped;
+    total.num_observed += p.num_observed;
   }
   if (stats) *stats = total;
 }

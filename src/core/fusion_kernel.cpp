@@ -81,7 +81,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
 {
   float* __restrict base = in.base;
   ConflictSums sums;
-  std::size_t skipped = 0;
+  std::size_t skipped = 0, observed = 0;
   const ContextualDiscountWeights8 w8(w);
   forEachCell(in.cells, [&](auto lane, std::size_t i) MAF_LAMBDA_INLINE {
     using T = decltype(lane);
@@ -102,6 +102,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
           skipped += kLanes;
           return;
         }
+        if (!vacuous) observed += kLanes;
       }
     }
     T m[kSubsets];
@@ -182,6 +183,7 @@ MAF_INLINE void fusionLoop(const StepInputs& in, const ContextualDiscountWeights
   sums.reduce(stats);
   stats.num_cells = in.cells;
   stats.num_skipped = skipped;
+  stats.num_observed = observed;
 }
 
 }  // namespace

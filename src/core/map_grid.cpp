@@ -919,6 +919,7 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   decisions.skip = prepareSkip(step_prior.grid != nullptr, step_prior.doubt != nullptr, skip);
   fusionStep(grid_, projection_, step_prior, fp, &stats, &betp_, parallel_.get(), &decisions);
   skipped_share_ = grid_.numCells() > 0 ? static_cast<double>(stats.num_skipped) / grid_.numCells() : 0.0;
+  observed_share_ = grid_.numCells() > 0 ? static_cast<double>(stats.num_observed) / grid_.numCells() : 0.0;
   const std::vector<std::size_t>* spread = nullptr;
   spreadMotionCells(grid_, betp_, projection_.occupied().data(), params_.motion_share, params_.motion_max_cells,
                     params_.decision_threshold, params_.motion_margin, parallel_.get(), &motion_seeds_, spread);

@@ -379,7 +379,8 @@ void FusionWorker::checkClock()
 void FusionWorker::LatencyWindows::setSpan(double span)
 {
   for (core::SlidingSamples* w : { &cloud_to_callback, &cloud_to_decision, &conversion, &shift, &shift_ahead,
-                                   &project_scan, &prior_window, &fusion, &tracking, &outputs, &skipped })
+                                   &project_scan, &prior_window, &fusion, &tracking, &outputs, &skipped,
+                                   &changing })
     w->setSpan(span);
 }
 
@@ -578,6 +579,8 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   latency_.prior_window.add(now, kMillisecondsPerSecond * times.prior_window);
   latency_.fusion.add(now, kMillisecondsPerSecond * times.fusion);
   latency_.skipped.add(now, grid_.skippedShare());
+  if (grid_.params().skip_unchanged)
+    latency_.changing.add(now, std::max(0.0, 1.0 - grid_.skippedShare() - grid_.observedShare()));
   latency_.tracking.add(now, ms(tracking_start, outputs_start));
   latency_.outputs.add(now, ms(outputs_start, end));
 }
@@ -733,11 +736,16 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   quantiles("stage fusion step", latency_.fusion);
   quantiles("stage tracking", latency_.tracking);
   quantiles("stage outputs", latency_.outputs);
-  const double skipped = latency_.skipped.quantile(now, 0.5);
-  if (std::isnan(skipped))
-    status.add("cells skipped (skip_unchanged) median [share]", "none");
-  else
-    status.add("cells skipped (skip_unchanged) median [share]", skipped);
+  for (const auto& [key, samples] : { std::pair{ "cells skipped (skip_unchanged) median [share]", &latency_.skipped },
+                                      std::pair{ "cells changing unobserved (skip_unchanged) median [share]",
+                                                 &latency_.changing } })
+  {
+    const double share = samples->quantile(now, 0.5);
+    if (std::isnan(share))
+      status.add(key, "none");
+    else
+      status.add(key, share);
+  }
   status.add("mean conflict", last_mean_conflict_);
   status.add("memory [MiB]", grid_.params().bytesNeeded() / (1024.0 * 1024.0));
   status.add("prior", softener_.raw() ? "received" : "none (vacuous)");

@@ -2,7 +2,9 @@
 // on a projected ScanGrid.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -100,6 +102,65 @@ TEST(ScanProjection, AnyRunsOfCellsAreWhatProjectScanWrites)
         EXPECT_GT(occupied, n / 50) << what;
         EXPECT_GT(sampled, clearance ? n / 20 : n / 2) << what;  // the clearance takes the free mass near obstacles
       }
+}
+
+TEST(ScanProjection, PointOccupancyIsTheLargestOccupiedMassOfTheReturnsInEachCell)
+{
+  // By definition: the window cell under a return in an occupied scan cell takes that cell's m(O) (the largest of its
+  // returns'), with m(F) = 0 and m(Ω) = 1 − m(O); no other cell holds m(O). The returns come several to a cell, some
+  // repeated in a row, some in free or vacuous cells, outside the scan grid or the window, or not finite.
+  RandomScan scan(5);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  std::vector<float> xy;
+  for (std::size_t k = 0; k + 1 < scan.xy.size(); k += 2)
+    for (int copy = 0; copy < 3; ++copy)
+    {
+      const double dx = copy == 1 ? 0.0 : jitter(rng) * kScanRes, dy = copy == 1 ? 0.0 : jitter(rng) * kScanRes;
+      xy.push_back(static_cast<float>(scan.xy[k] + dx));
+      xy.push_back(static_cast<float>(scan.xy[k + 1] + dy));
+    }
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (const auto& [x, y] : { std::pair{ nan, 1.0f }, std::pair{ 1.0f, inf }, std::pair{ -inf, 0.0f },
+                              std::pair{ 25.0f, 0.0f }, std::pair{ 0.0f, -18.0f }, std::pair{ 0.5f, 0.5f } })
+  {
+    xy.push_back(x);
+    xy.push_back(y);
+  }
+  const ObstaclePoints points{ xy.data(), xy.size() / 2 };
+  const GridGeometry& sg = scan.grid.geometry();
+  const GridGeometry window = GridGeometry::centred(30.0, 24.0, kWindowRes);
+  ScanMassGrid projected;
+  for (const Pose2 pose : { Pose2{ 0.0, 0.0, 0.0 }, Pose2{ 1.1, -0.4, 0.6 }, Pose2{ -3.3, 2.05, -2.3 } })
+    for (const int threads : { 1, 2 })
+    {
+      const Parallel parallel(threads);
+      projectScan(scan.grid, pose, window, projected, &points, 0, &parallel);
+      std::vector<float> expected(window.numCells(), 0.0f);
+      const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+      std::size_t marked = 0;
+      for (std::size_t k = 0; k < points.count; ++k)
+      {
+        const double vx = xy[2 * k], vy = xy[2 * k + 1];
+        CellIndex sc, wc;
+        if (!sg.worldToCell(Point2{ vx, vy }, sc)) continue;
+        const float occupied = scan.grid.at(FrameSG::kO, sg.index(sc));
+        if (!(occupied > 0.0f)) continue;
+        if (!window.worldToCell(Point2{ pose.x + c * vx - s * vy, pose.y + s * vx + c * vy }, wc)) continue;
+        float& e = expected[window.index(wc)];
+        e = std::max(e, occupied);
+        ++marked;
+      }
+      ASSERT_GT(marked, points.count / 4);
+      std::size_t wrong = 0;
+      for (std::size_t j = 0; j < window.numCells(); ++j)
+      {
+        wrong += projected.at(FrameSG::kO, j) != expected[j];
+        if (expected[j] > 0.0f)
+          wrong += projected.at(FrameSG::kF, j) != 0.0f || projected.at(FrameSG::kOmega, j) != 1.0f - expected[j];
+      }
+      EXPECT_EQ(wrong, 0u) << "yaw " << pose.yaw << ", " << threads << " threads";
+    }
 }
 
 TEST(ScanProjection, FusedStepOnTheFilledChunksEqualsTheStepOnTheProjectedScanGrid)

@@ -281,3 +281,46 @@ TEST(SkipUnchanged, TheSkippedShareCountsWholeBlocksOfUnseenCells)
     EXPECT_LE(on.skipped[k], 1.0 - seen + 0.01) << "a cell the scan sees is never skipped (scan " << k << ")";
   }
 }
+
+TEST(SkipUnchanged, CountsTheCellsOfTheBlocksTheScanObserves)
+{
+  // A scan that observes a disc, free: FusionStepStats::num_observed is every cell of each block holding a cell of
+  // the disc, scan after scan; the rest is skipped or still changing.
+  MapGridParams params = defaultProfile().map_grid;
+  params.size_x = params.size_y = kWindow;
+  params.resolution = kResolution;
+  const GridGeometry sg = GridGeometry::centred(kWindow, kWindow, kResolution);
+  ScanMassGrid scan(sg);
+  std::size_t expected = 0;
+  const std::size_t block = MapMassGrid::kBlockCells;
+  for (std::size_t b = 0; b < scan.numCells() / block; ++b)
+  {
+    bool seen = false;
+    for (std::size_t i = b * block; i < (b + 1) * block; ++i)
+    {
+      const Point2 c = sg.cellCentre(sg.cellOf(i));
+      if (c.x * c.x + c.y * c.y > kSeenRadius * kSeenRadius) continue;
+      scan.setCell(i, MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } });
+      seen = true;
+    }
+    expected += seen ? block : 0;
+  }
+  ASSERT_GT(expected, 0u);
+  const PriorWindow prior = randomPrior(3);
+  for (const bool skip : { true, false })
+  {
+    params.skip_unchanged = skip;
+    MapGrid grid(params);
+    for (int k = 0; k < 30; ++k)
+    {
+      const FusionStepStats s = grid.update(scan, Pose2{}, 0.1 * k, &prior);
+      ASSERT_TRUE(grid.geometry() == sg) << "the window is the scan's grid";
+      EXPECT_EQ(s.num_observed, skip ? expected : 0u) << "skip " << skip << ", scan " << k;
+      EXPECT_LE(s.num_observed + s.num_skipped, s.num_cells) << "scan " << k;
+      if (skip && k == 29)
+      {
+        EXPECT_GT(s.num_skipped, 0u) << "the unseen cells reach their fixed point";
+      }
+    }
+  }
+}

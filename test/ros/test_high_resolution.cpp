@@ -57,6 +57,8 @@ double median(std::vector<double> v)
 
 /// The share of cells the fusion's step skipped, windowed median.
 constexpr const char* kSkippedKey = "cells skipped (skip_unchanged) median [share]";
+/// The share of cells it computed although the scan did not observe them, windowed median.
+constexpr const char* kChangingKey = "cells changing unobserved (skip_unchanged) median [share]";
 /// The window shifts the fusion made on `scan_grid/started`, before their scans (shift_ahead), since it started.
 constexpr const char* kShiftsAheadKey = "window shifts ahead (shift_ahead)";
 
@@ -73,6 +75,7 @@ struct StageSamples
   std::vector<double> scan_grid_ms, update_ms, callback_ms;
   std::map<std::string, double> windowed;  ///< the last windowed median/p90 of each key (ms), while clouds flow
   double skipped_share = -1.0;              ///< the last kSkippedKey
+  double changing_share = -1.0;             ///< the last kChangingKey
   double shifts_ahead = -1.0;               ///< the last kShiftsAheadKey
 
   void add(const diagnostic_msgs::DiagnosticArray& m)
@@ -99,6 +102,7 @@ struct StageSamples
             for (const char* unit : { " [ms]", " (ms)" })
               if (auto it = v.find(std::string(key) + q + unit); it != v.end()) windowed[std::string(key) + q] = it->second;
       if (auto it = v.find(kSkippedKey); it != v.end()) skipped_share = it->second;
+      if (auto it = v.find(kChangingKey); it != v.end()) changing_share = it->second;
       if (auto it = v.find(kShiftsAheadKey); it != v.end()) shifts_ahead = it->second;
       if (endsWith(": ScanGrid") && v.count("processing time mean (ms)") && v["processing time mean (ms)"] > 0.0)
         scan_grid_ms.push_back(v["processing time mean (ms)"]);
@@ -242,6 +246,11 @@ TEST(HighResolution, CloudsAtTenHertzThroughTheThreeNodelets)
   std::cout << "  cells the fused step skipped (skip_unchanged), median share: " << stages.skipped_share << "\n";
   RecordProperty("skipped_share_percent", static_cast<int>(std::lround(100.0 * stages.skipped_share)));
   EXPECT_GE(stages.skipped_share, 0.0) << "the fusion reports " << kSkippedKey;
+  std::cout << "  cells it computed although the scan did not observe them, median share: " << stages.changing_share
+            << "\n";
+  RecordProperty("changing_share_percent", static_cast<int>(std::lround(100.0 * stages.changing_share)));
+  EXPECT_GE(stages.changing_share, 0.0) << "the fusion reports " << kChangingKey;
+  EXPECT_LE(stages.changing_share + stages.skipped_share, 1.0 + 1e-9);
   EXPECT_TRUE(stages.windowed.count("latency cloud to decision median")) << "the fusion reports its latency";
   EXPECT_TRUE(stages.windowed.count("stage fusion step p90"));
   EXPECT_TRUE(stages.windowed.count("processing time p90")) << "the ScanGrid reports its build time";

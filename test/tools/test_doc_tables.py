@@ -142,10 +142,36 @@ def test_bench_table_shows_the_drive_counter(tmp_path):
                 {"name": drive.format(0) + "_median", "run_name": drive.format(0), "run_type": "aggregate",
                  "aggregate_name": "median", "real_time": 10.0, "time_unit": "ms", "repetitions": 3, "skipped_share": 0.0},
                 {"name": drive.format(1) + "_median", "run_name": drive.format(1), "run_type": "aggregate",
-                 "aggregate_name": "median", "real_time": 8.0, "time_unit": "ms", "repetitions": 3, "skipped_share": 0.456},
+                 "aggregate_name": "median", "real_time": 8.0, "time_unit": "ms", "repetitions": 3, "skipped_share": 0.456,
+                 "observed_share": 0.1, "changing_share": 0.444},
+                {"name": "BM_ScansToFixedPoint/history:1/iterations:1_median",
+                 "run_name": "BM_ScansToFixedPoint/history:1/iterations:1", "run_type": "aggregate",
+                 "aggregate_name": "median", "real_time": 4.0, "time_unit": "ms", "repetitions": 3, "scans": 428.0},
             ]}
     path = tmp_path / "bench.json"
     path.write_text(json.dumps(data))
     out = subprocess.run([sys.executable, BENCH, str(path)], check=True, capture_output=True, text=True).stdout
-    assert ("| `BM_MapGridUpdateDrive/n:800/threads:2/skip:1` | the same with `skip_unchanged`; skipped share 0.46 | "
-            "8.000 | 0.80 | `BM_MapGridUpdateDrive/n:800/threads:2/skip:0` |") in out
+    assert ("| `BM_MapGridUpdateDrive/n:800/threads:2/skip:1` | the same with `skip_unchanged`; skipped share 0.46, "
+            "observed share 0.10, changing share 0.44 | 8.000 | 0.80 | `BM_MapGridUpdateDrive/n:800/threads:2/skip:0` |") in out
+    assert "| `BM_ScansToFixedPoint/history:1` | the same for a cell seen occupied on a mapped road (a parked car that left); scans 428 | 4.000 |  |  |" in out
+
+
+def test_bench_table_bounds_the_drive_with_free_skips(tmp_path):
+    drive = "BM_MapGridUpdateDrive/n:{}/threads:2/skip:{}/iterations:200/real_time"
+    stages = {"shift_ms": 0.5, "project_ms": 0.25, "prior_ms": 0.0, "fusion_ms": 4.0}
+    benchmarks = []
+    for n in (800, 200):
+        benchmarks.append({"name": drive.format(n, 0) + "_median", "run_name": drive.format(n, 0), "run_type": "aggregate",
+                           "aggregate_name": "median", "real_time": 5.0, "time_unit": "ms", "repetitions": 3,
+                           "skipped_share": 0.0, **stages})
+        benchmarks.append({"name": drive.format(n, 1) + "_median", "run_name": drive.format(n, 1), "run_type": "aggregate",
+                           "aggregate_name": "median", "real_time": 4.0, "time_unit": "ms", "repetitions": 3,
+                           "skipped_share": 0.75 if n == 800 else 0.5, **stages})
+    data = {"context": {"host_name": "h", "num_cpus": 2, "mhz_per_cpu": 2000, "date": "2026-12-03T10:00:00"},
+            "benchmarks": benchmarks}
+    path = tmp_path / "bench.json"
+    path.write_text(json.dumps(data))
+    out = subprocess.run([sys.executable, BENCH, str(path)], check=True, capture_output=True, text=True).stdout
+    # 0.5 + 0.25 + 0 + 4 × (1 − skipped)
+    assert ("would still take 1.75 ms at 800 × 800 (computing 0.25 of the cells) and 2.75 ms at 200 × 200 "
+            "(computing 0.50 of the cells)") in out

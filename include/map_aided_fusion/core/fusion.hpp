@@ -93,6 +93,9 @@ struct FusionStepStats
   double sum_conflict_other = 0.0;          ///< Σ remaining conflict over cells
   std::size_t num_cells = 0;
   std::size_t num_skipped = 0;  ///< cells of num_cells the step left as they were without computing them (StepSkip)
+  /// With StepSkip: cells of num_cells in blocks whose scan was not vacuous (the scan observed them). The cells neither
+  /// skipped nor observed are those still changing under a vacuous scan (evidence decaying towards the prior).
+  std::size_t num_observed = 0;
   double meanConflict() const
   {
     return num_cells ? (sum_conflict_free_occupied + sum_conflict_occupied_free + sum_conflict_other) / num_cells : 0.0;

@@ -352,6 +352,9 @@ public:
   }
   /// Share of the last update's cells that skip_unchanged skipped, in [0, 1].
   double skippedShare() const { return skipped_share_; }
+  /// Share of the last update's cells the scan observed (FusionStepStats::num_observed; 0 without skip_unchanged), in
+  /// [0, 1]. The cells neither skipped nor observed changed under a vacuous scan: evidence decaying towards the prior.
+  double observedShare() const { return observed_share_; }
   const GridGeometry& geometry() const { return grid_.geometry(); }
   /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
   const PignisticPlanes& pignistic() const { return betp_; }
@@ -402,6 +405,7 @@ private:
   AlignedVector<float> kept_[4];
   int skip_inputs_ = -1;
   double skipped_share_ = 0.0;
+  double observed_share_ = 0.0;
 
   void forgetStable() { std::fill(stable_.begin(), stable_.end(), std::uint8_t{ 0 }); }
   void forgetStable(const std::vector<std::size_t>& cells);

@@ -190,6 +190,7 @@ private:
         tracking, outputs;
     core::SlidingSamples shift_ahead;  ///< the shifts made on `scan_grid/started`, before the scan's callback
     core::SlidingSamples skipped;  ///< share of the window's cells the step skipped (MapGridParams::skip_unchanged)
+    core::SlidingSamples changing;  ///< share the step computed under a vacuous scan (neither skipped nor observed)
     void setSpan(double span);
   };
   LatencyWindows latency_;
