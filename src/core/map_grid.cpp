@@ -920,6 +920,8 @@ FusionStepStats MapGrid::update(const ScanMassGrid& scan, const Pose2& pose, dou
   fusionStep(grid_, projection_, step_prior, fp, &stats, &betp_, parallel_.get(), &decisions);
   skipped_share_ = grid_.numCells() > 0 ? static_cast<double>(stats.num_skipped) / grid_.numCells() : 0.0;
   observed_share_ = grid_.numCells() > 0 ? static_cast<double>(stats.num_observed) / grid_.numCells() : 0.0;
+  changing_share_ = decisions.skip ? std::max(0.0, 1.0 - skipped_share_ - observed_share_)
+                                   : std::numeric_limits<double>::quiet_NaN();
   const std::vector<std::size_t>* spread = nullptr;
   spreadMotionCells(grid_, betp_, projection_.occupied().data(), params_.motion_share, params_.motion_max_cells,
                     params_.decision_threshold, params_.motion_margin, parallel_.get(), &motion_seeds_, spread);

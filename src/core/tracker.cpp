@@ -67,11 +67,11 @@ bool openAnchor(const Track& t, const Measurement& m, const TrackerParams& p)
   return (m.open & (a.anchor_lo ? Measurement::kLowU : Measurement::kHighU)) != 0;
 }
 
-/// Step far growth (TrackerParams::far_growth): @p m is placed by its open anchoring end (openAnchor()) and its major
-/// axis is one of @p t's box axes.
-bool farGrowth(const Track& t, const Measurement& m, const TrackerParams& p)
+/// Step far growth (TrackerParams::far_growth): @p m is placed by its open anchoring end (@p open, openAnchor()) and
+/// its major axis is one of @p t's box axes.
+bool farGrowth(const Track& t, const Measurement& m, const TrackerParams& p, bool open)
 {
-  return p.far_growth && openAnchor(t, m, p) && std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) <= kMinAxesTurn;
+  return open && p.far_growth && std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) <= kMinAxesTurn;
 }
 
 /// The measurement's covariance, grown by the change of the cluster's extent since the track's last cluster: a
@@ -82,9 +82,10 @@ Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, cons
 {
   const double dl = 0.5 * std::abs(m.length - t.length), dw = 0.5 * std::abs(m.width - t.width);
   const Eigen::Vector2d major(std::cos(m.yaw), std::sin(m.yaw)), minor(-major.y(), major.x());
-  const double along = (farGrowth(t, m, p) ? 0.0 : dl * dl) +
+  const bool open = openAnchor(t, m, p);
+  const double along = (farGrowth(t, m, p, open) ? 0.0 : dl * dl) +
                        (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
-  if (openAnchor(t, m, p))
+  if (open)
   {
     const double su = p.measurement_sigma, sv = clusterSigma(p, m.width);
     return (su * su + along) * major * major.transpose() + (sv * sv + dw * dw) * minor * minor.transpose();
@@ -1060,8 +1061,9 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     {
       if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
       if (hiddenEnds(t, measurements_[pairs[r]], params_)) ++counts_.hidden_ends;
-      if (openAnchor(t, measurements_[pairs[r]], params_)) ++counts_.open_anchor;
-      if (farGrowth(t, measurements_[pairs[r]], params_)) ++counts_.far_growth;
+      const bool open = openAnchor(t, measurements_[pairs[r]], params_);
+      counts_.open_anchor += open;
+      counts_.far_growth += farGrowth(t, measurements_[pairs[r]], params_, open);
       if (correct(t, measurements_[pairs[r]], stamp)) ++counts_.long_box;
       used[pairs[r]] = 1;
       t.measurement = pairs[r];

@@ -579,8 +579,7 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
   latency_.prior_window.add(now, kMillisecondsPerSecond * times.prior_window);
   latency_.fusion.add(now, kMillisecondsPerSecond * times.fusion);
   latency_.skipped.add(now, grid_.skippedShare());
-  if (grid_.params().skip_unchanged)
-    latency_.changing.add(now, std::max(0.0, 1.0 - grid_.skippedShare() - grid_.observedShare()));
+  if (!std::isnan(grid_.changingShare())) latency_.changing.add(now, grid_.changingShare());
   latency_.tracking.add(now, ms(tracking_start, outputs_start));
   latency_.outputs.add(now, ms(outputs_start, end));
 }

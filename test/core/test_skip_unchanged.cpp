@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <string>
@@ -317,6 +318,14 @@ TEST(SkipUnchanged, CountsTheCellsOfTheBlocksTheScanObserves)
       ASSERT_TRUE(grid.geometry() == sg) << "the window is the scan's grid";
       EXPECT_EQ(s.num_observed, skip ? expected : 0u) << "skip " << skip << ", scan " << k;
       EXPECT_LE(s.num_observed + s.num_skipped, s.num_cells) << "scan " << k;
+      if (skip)
+      {
+        EXPECT_DOUBLE_EQ(grid.changingShare(), 1.0 - grid.skippedShare() - grid.observedShare()) << "scan " << k;
+      }
+      else
+      {
+        EXPECT_TRUE(std::isnan(grid.changingShare())) << "no cells told apart without the skip";
+      }
       if (skip && k == 29)
       {
         EXPECT_GT(s.num_skipped, 0u) << "the unseen cells reach their fixed point";

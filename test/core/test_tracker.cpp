@@ -41,6 +41,18 @@ Measurement at(double x, double y, double sigma = 0.2)
   return m;
 }
 
+/// @p m with a @p length × @p width extent centred on its centroid, its major axis along its yaw.
+Measurement withExtent(Measurement m, double length, double width)
+{
+  m.length = length;
+  m.width = width;
+  m.lo_u = -0.5 * length;
+  m.hi_u = 0.5 * length;
+  m.lo_v = -0.5 * width;
+  m.hi_v = 0.5 * width;
+  return m;
+}
+
 const Track* byId(const Tracker& t, std::uint32_t id)
 {
   for (const Track& k : t.tracks())
@@ -1811,13 +1823,7 @@ namespace {
 
 Measurement piece(double x, double y, double length, double width, bool split)
 {
-  Measurement m = at(x, y, 0.15);
-  m.length = length;
-  m.width = width;
-  m.lo_u = -0.5 * length;
-  m.hi_u = 0.5 * length;
-  m.lo_v = -0.5 * width;
-  m.hi_v = 0.5 * width;
+  Measurement m = withExtent(at(x, y, 0.15), length, width);
   m.split = split;
   return m;
 }
@@ -1912,13 +1918,7 @@ constexpr double kCornerYaw = 0.37, kCornerLength = 1.10, kCornerWidth = 0.53;
 /// driving along −x) open, its +x end occluded while the car is still partly in a shadow.
 Measurement sideOf(double front, double length, double width, bool in_shadow)
 {
-  Measurement m = at(front + 0.5 * length, 2.4, 0.15);
-  m.length = length;
-  m.width = width;
-  m.lo_u = -0.5 * length;
-  m.hi_u = 0.5 * length;
-  m.lo_v = -0.5 * width;
-  m.hi_v = 0.5 * width;
+  Measurement m = withExtent(at(front + 0.5 * length, 2.4, 0.15), length, width);
   m.has_sensor = true;
   m.sensor = Point2{ 20.0, 42.0 };
   m.ends_seen = true;
@@ -2206,13 +2206,7 @@ constexpr double kBusSpeed = 6.6, kBusBraking = 1.5;  // m/s, m/s²
 /// sensor and which of its ends step open ends saw (set them).
 Measurement boxCluster(double x, double y, double length, double width, const TrackerParams& params)
 {
-  Measurement m = at(x, y);
-  m.length = length;
-  m.width = width;
-  m.lo_u = -0.5 * length;
-  m.hi_u = 0.5 * length;
-  m.lo_v = -0.5 * width;
-  m.hi_v = 0.5 * width;
+  Measurement m = withExtent(at(x, y), length, width);
   const double su = params.measurement_sigma + params.extent_sigma * length;
   const double sv = params.measurement_sigma + params.extent_sigma * width;
   m.covariance = Eigen::Vector2d(su * su, sv * sv).asDiagonal();

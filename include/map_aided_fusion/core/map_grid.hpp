@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -353,8 +354,12 @@ public:
   /// Share of the last update's cells that skip_unchanged skipped, in [0, 1].
   double skippedShare() const { return skipped_share_; }
   /// Share of the last update's cells the scan observed (FusionStepStats::num_observed; 0 without skip_unchanged), in
-  /// [0, 1]. The cells neither skipped nor observed changed under a vacuous scan: evidence decaying towards the prior.
+  /// [0, 1].
   double observedShare() const { return observed_share_; }
+  /// Share of the last update's cells neither skipped nor observed, in [0, 1]: computed under a vacuous scan, their
+  /// evidence still decaying towards the prior. NaN when that update did not skip (skip_unchanged off, or
+  /// alpha_per_second), since the step then tells no cells apart.
+  double changingShare() const { return changing_share_; }
   const GridGeometry& geometry() const { return grid_.geometry(); }
   /// BetP of every cell after the last update (F, C, N, S, V planes), computed in the fusion pass.
   const PignisticPlanes& pignistic() const { return betp_; }
@@ -406,6 +411,7 @@ private:
   int skip_inputs_ = -1;
   double skipped_share_ = 0.0;
   double observed_share_ = 0.0;
+  double changing_share_ = std::numeric_limits<double>::quiet_NaN();
 
   void forgetStable() { std::fill(stable_.begin(), stable_.end(), std::uint8_t{ 0 }); }
   void forgetStable(const std::vector<std::size_t>& cells);
