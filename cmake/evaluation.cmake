@@ -10,6 +10,7 @@ install(TARGETS map_aided_fusion_eval
 
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_metrics test/eval/test_metrics.cpp test/eval/test_movers.cpp test/eval/test_clear_mot.cpp
+    test/eval/test_point_labels.cpp
     test/test_main.cpp)
   target_link_libraries(test_metrics map_aided_fusion_eval)
 endif()

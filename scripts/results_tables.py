@@ -4,7 +4,8 @@
     results_tables.py OUT [--doc DOC_DIR --readme README.md]
 
 Writes OUT/results.md (every table) and OUT/results_summary.md (the README's table: default against paper on the
-simulator, KITTI 00, KITTI tracking and the held-out drives, OUT/held_out from learning/held_out). With --doc and
+simulator, the labelled real sequences pooled (OUT/real/NAME), KITTI tracking and the held-out drives, OUT/held_out
+from learning/held_out), and OUT/real/pooled.json (the real sequences' counts summed per variant). With --doc and
 --readme, and only when every dataset was evaluated, also
 DOC_DIR/results.md, the README's block between the `results:begin` and `results:end` markers and (--figure) the
 picture under DOC_DIR/images/: the documentation then shows what this run measured, never a typed figure.
@@ -19,7 +20,18 @@ BEGIN = "<!-- results:begin (scripts/demo writes this table; do not edit) -->"
 END = "<!-- results:end -->"
 
 SIMULATOR = "default scenario (simulator, 600 scans, town map)"
-KITTI00 = "KITTI 00 (real, 10 sweeps, 3 labelled, no map)"
+REAL = "Labelled real sequences (KITTI 00, SemanticKITTI 02, 06, 09, 10; 10 sweeps each, every point labelled, no map)"
+# The labelled real sequences scripts/demo scores (out/real/NAME): name, title; KITTI 00 twice (two sources of pose).
+REAL_SEQUENCES = [
+    ("kitti_00", "KITTI 00, GPS/INS poses"),
+    ("kitti_00_suma", "KITTI 00, SemanticKITTI poses"),
+    ("semantic_kitti_02", "SemanticKITTI 02"),
+    ("semantic_kitti_06", "SemanticKITTI 06"),
+    ("semantic_kitti_09", "SemanticKITTI 09 (nothing moves)"),
+    ("semantic_kitti_10", "SemanticKITTI 10"),
+]
+# The pooled real set: each drive once (KITTI 00 with its GPS/INS poses).
+REAL_POOLED = ("kitti_00", "semantic_kitti_02", "semantic_kitti_06", "semantic_kitti_09", "semantic_kitti_10")
 TRACKING = "KITTI tracking 0000 (real, 154 sweeps, 5 movers, no map)"
 HELD_OUT = "Held-out drives (simulator, `learning/drives.yaml`)"
 
@@ -68,6 +80,93 @@ SIM_COLUMNS = [
     ("MOTA", lambda v: num(v.get("tracks.mota"), 2)),
     ("velocity RMSE (m/s)", lambda v: num(v.get("tracks.velocity_rmse_mps"), 2)),
 ]
+def counted(v, num_key, den_key, digits=3, scale=1.0):
+    """A ratio of two of `evaluate`'s counts ("counts.*"), "–" when there is nothing to count."""
+    c = v.get("counts", v)
+    a, b = c.get(num_key), c.get(den_key)
+    if a is None or b is None or b <= 0:
+        return "–"
+    return f"{scale * a / b:.{digits}f}"
+
+
+def iou(v):
+    c = v.get("counts", v)
+    tp, fp, fn = (c.get(k) for k in ("moving_tp", "moving_fp", "moving_fn"))
+    if tp is None or tp + fp + fn <= 0:
+        return "–"
+    return f"{tp / (tp + fp + fn):.3f}"
+
+
+def f1(v):
+    c = v.get("counts", v)
+    tp, fp, fn = (c.get(k) for k in ("segmentation_tp", "segmentation_fp", "segmentation_fn"))
+    if tp is None or 2 * tp + fp + fn <= 0:
+        return "–"
+    return f"{2 * tp / (2 * tp + fp + fn):.3f}"
+
+
+# Columns of the labelled real sequences; each a ratio of counts, so that sequences pool by summing them.
+REAL_COLUMNS = [
+    ("false V / labelled sweep", lambda v: counted(v, "false_v", "labelled_sweeps", 1)),
+    ("movers' cells V", lambda v: counted(v, "mover_v_cells", "mover_cells", 2)),
+    ("moving IoU (points)", iou),
+    ("ground cells F", lambda v: counted(v, "ground_f_cells", "ground_cells")),
+    ("ground cells F, settled", lambda v: counted(v, "ground_f_cells_settled", "ground_cells_settled")),
+    ("obstacle cells F (%)", lambda v: counted(v, "obstacle_f_cells", "obstacle_cells", 3, 100.0)),
+    ("ground F1 (points)", f1),
+    ("ground returns called obstacle", lambda v: counted(v, "ground_as_obstacle", "ground_points")),
+]
+
+
+def real_counts(v):
+    """The counts of one variant of a labelled real sequence's metrics.json, with the sweeps and ground points."""
+    c = {k[len("counts."):]: x for k, x in v.items() if k.startswith("counts.")}
+    c["labelled_sweeps"] = v.get("labelled_sweeps", 0)
+    if "segmentation_tp" in c:
+        c["ground_points"] = c["segmentation_tp"] + c["segmentation_fn"]
+    return c
+
+
+def pool_real(real, names=REAL_POOLED):
+    """Per variant present in every named sequence, the sum of their counts: {variant: {"counts": {...}}}."""
+    present = [real[n] for n in names if n in real]
+    if not present:
+        return {}
+    variants = [v for v in present[0] if all(v in r for r in present)]
+    pooled = {}
+    for v in variants:
+        total = {}
+        for r in present:
+            for k, x in real_counts(r[v]).items():
+                total[k] = total.get(k, 0) + x
+        pooled[v] = {"counts": total, "sequences": len(present)}
+    return pooled
+
+
+def real_table(real, pooled):
+    """Each labelled real sequence and the pool, default, paper and live rows, in REAL_COLUMNS."""
+    lines = ["| sequence | variant | " + " | ".join(c for c, _ in REAL_COLUMNS) + " |",
+             "| --- | --- | " + " | ".join("---:" for _ in REAL_COLUMNS) + " |"]
+    for name, title in REAL_SEQUENCES:
+        for variant in ("default", "live_default", "paper"):
+            if name in real and variant in real[name]:
+                c = {"counts": real_counts(real[name][variant])}
+                lines.append(f"| {title} | {variant} | " + " | ".join(f(c) for _, f in REAL_COLUMNS) + " |")
+    for variant in ("default", "live_default", "paper"):
+        if variant in pooled:
+            lines.append(f"| **pooled** ({pooled[variant]['sequences']} drives) | {variant} | " +
+                         " | ".join(f(pooled[variant]) for _, f in REAL_COLUMNS) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def real_variants_table(pooled):
+    """Every variant (the default, each step off, the paper and its ablations) on the pooled real sequences."""
+    lines = ["| variant | " + " | ".join(c for c, _ in REAL_COLUMNS) + " |",
+             "| --- | " + " | ".join("---:" for _ in REAL_COLUMNS) + " |"]
+    lines += [f"| {n} | " + " | ".join(f(v) for _, f in REAL_COLUMNS) + " |" for n, v in pooled.items()]
+    return "\n".join(lines) + "\n"
+
+
 KITTI_COLUMNS = [
     ("V cells / sweep", lambda v: num(v.get("v_cells_per_sweep"), 1)),
     ("false V / labelled sweep", lambda v: num(v.get("false_v_per_labelled_sweep"), 1)),
@@ -131,7 +230,7 @@ def held_out_table(held):
             "drives, not averaged; `learning/maf_learning/objective.py`).\n\n" + "\n".join(lines) + "\n")
 
 
-def summary(sim, kitti, tracking, held=None):
+def summary(sim, real_pooled, tracking, held=None):
     """One table: each dataset's key figures for the default and the paper profiles."""
     lines = ["| data | figure | default | paper |", "| --- | --- | ---: | ---: |"]
 
@@ -147,9 +246,12 @@ def summary(sim, kitti, tracking, held=None):
         pooled = {profile: v["pooled"] for profile, v in held["variants"].items()}
         for title in ("V precision", "V recall", "movers V ≤ 1 s", "MOTA", "velocity RMSE (m/s)"):
             add("held-out drives, pooled", pooled, title, cols[title])
-    cols = dict(KITTI_COLUMNS)
-    for title in ("false V / labelled sweep", "motorcyclist V share from its 3rd sweep"):
-        add("KITTI 00", kitti, title, cols[title])
+    if real_pooled:
+        cols = dict(REAL_COLUMNS)
+        data = f"real sequences, pooled ({next(iter(real_pooled.values()))['sequences']})"
+        for title in ("false V / labelled sweep", "movers' cells V", "moving IoU (points)", "ground cells F",
+                      "obstacle cells F (%)", "ground F1 (points)"):
+            add(data, real_pooled, title, cols[title])
     cols = dict(TRACKING_COLUMNS)
     for title in ("movers V ≤ 1 s", "movers' mean V share", "movers' cells S", "false V / scan", "MOTA"):
         add("KITTI tracking", tracking, title, cols[title])
@@ -164,7 +266,12 @@ def main():
     ap.add_argument("--figure", help="a picture to copy to DOC_DIR/images/ with the tables (figure2.png)")
     a = ap.parse_args()
     sim = load(os.path.join(a.out, "metrics.json"))
-    kitti = load(os.path.join(a.out, "kitti", "metrics.json"))
+    real = {n: v for n, v in ((n, load(os.path.join(a.out, "real", n, "metrics.json"))) for n, _ in REAL_SEQUENCES)
+            if v}
+    real_pooled = pool_real(real)
+    if real_pooled:
+        with open(os.path.join(a.out, "real", "pooled.json"), "w") as f:
+            json.dump({"sequences": [n for n in REAL_POOLED if n in real], "variants": real_pooled}, f, indent=1)
     tracking = load(os.path.join(a.out, "kitti_tracking", "metrics.json"))
     held = read_json(os.path.join(a.out, "held_out", "metrics.json"))  # learning/held_out's
     if sim is None:
@@ -176,12 +283,21 @@ def main():
              "replaying the bag; `default_without_<step>` is the default with one added step off (doc/steps.md), "
              "`dempster`, `yager`, `single_rate`, `no_counter` are ablations of the paper. "
              "doc/evaluation.md defines every figure.\n\n",
-             "## Summary\n\n", summary(sim, kitti, tracking, held),
+             "## Summary\n\n", summary(sim, real_pooled, tracking, held),
              f"\n## {SIMULATOR}\n\n", table(sim, SIM_COLUMNS), mover_tracks_table(sim)]
     if held:
         parts += [f"\n## {HELD_OUT}\n\n", held_out_table(held)]
-    if kitti:
-        parts += [f"\n## {KITTI00}\n\n", table(kitti, KITTI_COLUMNS)]
+    if real:
+        parts += [f"\n## {REAL}\n\n",
+                  "Scored per labelled sweep (doc/evaluation.md, \"Labelled real sweeps\"); `live_default` is the "
+                  "nodelets replaying the bag. Pooled: the counts of "
+                  + ", ".join(f"`{n}`" for n in REAL_POOLED) + " summed, then divided.\n\n",
+                  real_table(real, real_pooled)]
+        if real_pooled:
+            parts += ["\nEvery variant on the pooled real sequences (a step stays on by default only where it wins "
+                      "here and makes no sequence worse; doc/steps.md):\n\n", real_variants_table(real_pooled)]
+        if "kitti_00" in real:
+            parts += ["\nKITTI 00's motorcyclist (GPS/INS poses):\n\n", table(real["kitti_00"], KITTI_COLUMNS)]
     if tracking:
         parts += [f"\n## {TRACKING}\n\n", table(tracking, TRACKING_COLUMNS),
                   mover_tracks_table(tracking)]
@@ -201,12 +317,12 @@ def main():
     with open(os.path.join(a.out, "results.md"), "w") as f:
         f.write(text)
     with open(os.path.join(a.out, "results_summary.md"), "w") as f:
-        f.write(summary(sim, kitti, tracking, held))
+        f.write(summary(sim, real_pooled, tracking, held))
     print(f"wrote {a.out}/results.md")
 
     if a.doc and a.readme:
-        missing = [name for name, v in (("KITTI 00", kitti), ("KITTI tracking", tracking), ("held-out drives", held))
-                   if v is None]
+        missing = [title for name, title in REAL_SEQUENCES if name not in real]
+        missing += [name for name, v in (("KITTI tracking", tracking), ("held-out drives", held)) if v is None]
         if missing:
             print(f"results_tables.py: {', '.join(missing)} not evaluated (the real ones need ../shared/data, the "
                   "held-out drives learning/held_out): doc/results.md and the README are left as they are")
@@ -218,7 +334,7 @@ def main():
         i, j = readme.find(BEGIN), readme.find(END)
         if i < 0 or j < i:
             sys.exit(f"results_tables.py: {a.readme} has no results markers")
-        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, kitti, tracking, held) + readme[j:]
+        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, real_pooled, tracking, held) + readme[j:]
         with open(a.readme, "w") as f:
             f.write(readme)
         print(f"wrote {a.doc}/results.md and the README's results table")

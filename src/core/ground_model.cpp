@@ -10,6 +10,8 @@
 #include <pcl/sample_consensus/model_types.h>
 #include <pcl/segmentation/sac_segmentation.h>
 
+#include <Eigen/Eigenvalues>
+
 #include "map_aided_fusion/core/parameters.hpp"
 
 namespace map_aided_fusion {
@@ -20,13 +22,17 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr float kMinNormalZ = 1e-3f;
 }  // namespace
 
-const char* toString(GroundModel model) { return model == GroundModel::kPlanes ? "planes" : "flat"; }
+const char* toString(GroundModel model)
+{
+  return model == GroundModel::kPlanes ? "planes" : model == GroundModel::kZones ? "zones" : "flat";
+}
 
 GroundModel parseGroundModel(const std::string& name)
 {
   if (name == "flat") return GroundModel::kFlat;
   if (name == "planes") return GroundModel::kPlanes;
-  throw ParameterError("ground_model", "unknown model '" + name + "' (flat, planes)");
+  if (name == "zones") return GroundModel::kZones;
+  throw ParameterError("ground_model", "unknown model '" + name + "' (flat, planes, zones)");
 }
 
 struct GroundPlaneFitter::Pcl
@@ -56,8 +62,20 @@ GroundPlaneFitter& GroundPlaneFitter::operator=(const GroundPlaneFitter& other)
 void GroundPlaneFitter::configure(const GroundModelParams& params)
 {
   params_ = params;
-  sectors_ = std::max(1, params.sectors);
-  for (std::size_t k = 0; k < ring_edges2_.size(); ++k) ring_edges2_[k] = kGroundRingEdges[k] * kGroundRingEdges[k];
+  ring_edges2_.clear();
+  ring_sectors_.clear();
+  if (params.model == GroundModel::kZones)
+  {
+    for (const float e : kZoneRingEdges) ring_edges2_.push_back(e * e);
+    ring_sectors_.assign(kZoneRingSectors.begin(), kZoneRingSectors.end());
+  }
+  else
+  {
+    for (const float e : kGroundRingEdges) ring_edges2_.push_back(e * e);
+    ring_sectors_.assign(kGroundRings, std::max(1, params.sectors));
+  }
+  ring_first_.assign(1, 0);
+  for (const int n : ring_sectors_) ring_first_.push_back(ring_first_.back() + n);
   planes_.assign(static_cast<std::size_t>(numZones()), GroundPlane{ 0.0f, 0.0f, static_cast<float>(params.ground_height) });
   pcl_->seg.setOptimizeCoefficients(true);
   pcl_->seg.setModelType(pcl::SACMODEL_PLANE);
@@ -84,58 +102,205 @@ GroundFitStats GroundPlaneFitter::fit(const float* dx, const float* dy, const fl
     for (std::size_t i = 0; i < n; ++i) order_[next[zone[i]]++] = static_cast<std::uint32_t>(i);
   }
 
-  const float band = static_cast<float>(params_.search_band);
-  const float min_normal_z = std::max(kMinNormalZ, static_cast<float>(std::cos(params_.max_slope_deg * kDegToRad)));
-  const std::size_t min_points = static_cast<std::size_t>(params_.min_points);
-  pcl::PointCloud<pcl::PointXYZ>& cloud = *pcl_->cloud;
-  std::vector<std::uint32_t> candidates;
-  for (int ring = 0; ring < kGroundRings; ++ring)
-    for (int s = 0; s < sectors_; ++s)
+  for (int ring = 0; ring < numRings(); ++ring)
+  {
+    const float inner_radius = ring == 0 ? 0.0f : std::sqrt(ring_edges2_[static_cast<std::size_t>(ring - 1)]);
+    const float inner_from = ring < 2 ? 0.0f : std::sqrt(ring_edges2_[static_cast<std::size_t>(ring - 2)]);
+    for (int sector = 0; sector < ring_sectors_[static_cast<std::size_t>(ring)]; ++sector)
     {
-      const std::size_t k = static_cast<std::size_t>(ring * sectors_ + s);
-      const GroundPlane predicted = ring == 0 ? flat : planes_[k - static_cast<std::size_t>(sectors_)];
+      const std::size_t k = static_cast<std::size_t>(ring_first_[static_cast<std::size_t>(ring)] + sector);
+      const GroundPlane predicted = ring == 0 ? flat : planes_[innerZone(ring, sector)];
       planes_[k] = predicted;
-      candidates.clear();
-      for (std::uint32_t j = zone_begin_[k]; j < zone_begin_[k + 1]; ++j)
-      {
-        const std::uint32_t i = order_[j];
-        if (std::fabs(z[i] - predicted.at(dx[i], dy[i])) <= band) candidates.push_back(i);
-      }
-      if (candidates.size() < min_points)
-      {
-        ++st.few_points;
-        continue;
-      }
-      const std::size_t stride = (candidates.size() + kGroundMaxCandidates - 1) / kGroundMaxCandidates;
-      cloud.clear();
-      for (std::size_t j = 0; j < candidates.size(); j += stride)
-      {
-        const std::uint32_t i = candidates[j];
-        cloud.push_back(pcl::PointXYZ(dx[i], dy[i], z[i]));
-      }
-      pcl_->seg.setInputCloud(pcl_->cloud);
-      pcl_->seg.segment(pcl_->inliers, pcl_->coefficients);
-      const std::vector<float>& c = pcl_->coefficients.values;
-      if (pcl_->inliers.indices.size() < std::min(min_points, cloud.size()) || c.size() != 4)
-      {
-        ++st.few_points;
-        continue;
-      }
-      const float norm = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-      if (!(norm > 0.0f) || !(std::fabs(c[2]) / norm >= min_normal_z))
-      {
-        ++st.too_steep;
-        continue;
-      }
-      planes_[k] = GroundPlane{ -c[0] / c[2], -c[1] / c[2], -c[3] / c[2] };
-      ++st.fitted;
+      const bool own = params_.model == GroundModel::kZones ? fitLowest(k, predicted, inner_from, inner_radius, dx, dy, z, st)
+                                                             : fitRansac(k, predicted, dx, dy, z, st);
+      st.fitted += own;
     }
+  }
   if (st.fitted == 0)
   {
     planes_.assign(zones, flat);
     st.flat_fallback = true;
   }
   return st;
+}
+
+std::size_t GroundPlaneFitter::innerZone(int ring, int s) const
+{
+  const int outer = ring_sectors_[static_cast<std::size_t>(ring)];
+  const int inner = ring_sectors_[static_cast<std::size_t>(ring - 1)];
+  const int si = std::min(inner - 1, ((2 * s + 1) * inner) / (2 * outer));
+  return static_cast<std::size_t>(ring_first_[static_cast<std::size_t>(ring - 1)] + si);
+}
+
+bool GroundPlaneFitter::fitRansac(std::size_t k, const GroundPlane& predicted, const float* dx, const float* dy,
+                                  const float* z, GroundFitStats& st)
+{
+  const float band = static_cast<float>(params_.search_band);
+  const float min_normal_z = std::max(kMinNormalZ, static_cast<float>(std::cos(params_.max_slope_deg * kDegToRad)));
+  const std::size_t min_points = static_cast<std::size_t>(params_.min_points);
+  pcl::PointCloud<pcl::PointXYZ>& cloud = *pcl_->cloud;
+  candidates_.clear();
+  for (std::uint32_t j = zone_begin_[k]; j < zone_begin_[k + 1]; ++j)
+  {
+    const std::uint32_t i = order_[j];
+    if (std::fabs(z[i] - predicted.at(dx[i], dy[i])) <= band) candidates_.push_back(i);
+  }
+  if (candidates_.size() < min_points)
+  {
+    ++st.few_points;
+    return false;
+  }
+  const std::size_t stride = (candidates_.size() + kGroundMaxCandidates - 1) / kGroundMaxCandidates;
+  cloud.clear();
+  for (std::size_t j = 0; j < candidates_.size(); j += stride)
+  {
+    const std::uint32_t i = candidates_[j];
+    cloud.push_back(pcl::PointXYZ(dx[i], dy[i], z[i]));
+  }
+  pcl_->seg.setInputCloud(pcl_->cloud);
+  pcl_->seg.segment(pcl_->inliers, pcl_->coefficients);
+  const std::vector<float>& c = pcl_->coefficients.values;
+  if (pcl_->inliers.indices.size() < std::min(min_points, cloud.size()) || c.size() != 4)
+  {
+    ++st.few_points;
+    return false;
+  }
+  const float norm = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+  if (!(norm > 0.0f) || !(std::fabs(c[2]) / norm >= min_normal_z))
+  {
+    ++st.too_steep;
+    return false;
+  }
+  planes_[k] = GroundPlane{ -c[0] / c[2], -c[1] / c[2], -c[3] / c[2] };
+  return true;
+}
+
+namespace {
+
+/// The least-squares plane (PCA) of returns @p idx: false when they are fewer than 3 or all at one point.
+/// @p line: true when they lie along a line (their spread across it is below kGroundLineRatio of the spread
+/// along it), so that the plane's tilt across the line is not known.
+bool pcaPlane(const std::vector<std::uint32_t>& idx, const float* dx, const float* dy, const float* z,
+              Eigen::Vector3d& normal, Eigen::Vector3d& mean, bool* line = nullptr)
+{
+  if (idx.size() < 3) return false;
+  mean.setZero();
+  for (const std::uint32_t i : idx) mean += Eigen::Vector3d(dx[i], dy[i], z[i]);
+  mean /= static_cast<double>(idx.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const std::uint32_t i : idx)
+  {
+    const Eigen::Vector3d d = Eigen::Vector3d(dx[i], dy[i], z[i]) - mean;
+    cov.noalias() += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(1) > 0.0)) return false;
+  normal = eig.eigenvectors().col(0);
+  if (normal.z() < 0.0) normal = -normal;
+  if (line) *line = eig.eigenvalues()(1) < kGroundLineRatio * kGroundLineRatio * eig.eigenvalues()(2);
+  return normal.allFinite();
+}
+
+
+/// Whether @p plane, fitted to returns of centroid @p mean in a zone whose inner edge is @p inner_radius from the
+/// sensor, continues @p predicted, the ground of the zone within (from @p inner_from to inner_radius). At the zone's
+/// inner edge, on the centroid's direction, the plane may start at most @p band above the predicted ground (a
+/// platform, a wall's foot seen over an occluder), and below it by at most band plus what a slope of @p max_slope
+/// (rad) rises from there to the centroid (an embankment whose foot lies inside the zone). One that starts higher
+/// continues the ground only when it rises from it inside the zone within (an embankment whose foot lies there,
+/// where that zone kept the road's plane).
+bool continuesGround(const GroundPlane& plane, const GroundPlane& predicted, const Eigen::Vector3d& mean,
+                     double inner_from, double inner_radius, double band, double max_slope)
+{
+  const double r = std::hypot(mean.x(), mean.y());
+  const double ux = r > 0.0 ? mean.x() / r : 1.0, uy = r > 0.0 ? mean.y() / r : 0.0;
+  // Along the centroid's direction, plane − predicted = rise · s + offset at s metres from the sensor.
+  const double rise = (static_cast<double>(plane.a) - predicted.a) * ux + (static_cast<double>(plane.b) - predicted.b) * uy;
+  const double offset = static_cast<double>(plane.c) - predicted.c;
+  const double edge = std::min(r, inner_radius);
+  const double step = rise * edge + offset;
+  const double below = band + std::tan(max_slope) * std::max(0.0, r - edge);
+  if (step <= band && step >= -below) return true;
+  const double foot = rise > 0.0 ? -offset / rise : -1.0;
+  return rise > 0.0 && foot >= inner_from && foot <= edge;
+}
+
+}  // namespace
+
+bool GroundPlaneFitter::lowestPlane(std::size_t k, const GroundPlane& predicted, const float* dx, const float* dy,
+                                    const float* z, Eigen::Vector3d& normal, Eigen::Vector3d& mean, bool& line)
+{
+  const float band = static_cast<float>(params_.search_band);
+  const std::size_t min_points = static_cast<std::size_t>(params_.min_points);
+  // The zone's returns, reflections far below the predicted ground left out, lowest first.
+  candidates_.clear();
+  for (std::uint32_t j = zone_begin_[k]; j < zone_begin_[k + 1]; ++j)
+  {
+    const std::uint32_t i = order_[j];
+    if (z[i] >= predicted.at(dx[i], dy[i]) - band) candidates_.push_back(i);
+  }
+  if (candidates_.size() < min_points) return false;
+  std::sort(candidates_.begin(), candidates_.end(),
+            [z](std::uint32_t a, std::uint32_t b) { return z[a] < z[b] || (z[a] == z[b] && a < b); });
+  const std::size_t lowest = std::min(kGroundLowestPoints, candidates_.size());
+  double lpr = 0.0;
+  for (std::size_t j = 0; j < lowest; ++j) lpr += z[candidates_[j]];
+  lpr /= static_cast<double>(lowest);
+  inliers_.clear();
+  for (const std::uint32_t i : candidates_)
+  {
+    if (z[i] >= lpr + kGroundSeedBand) break;
+    inliers_.push_back(i);
+  }
+  for (int it = 0; it < kGroundFitIterations; ++it)
+  {
+    if (!pcaPlane(inliers_, dx, dy, z, normal, mean)) break;
+    const double d = -normal.dot(mean);
+    inliers_.clear();
+    for (const std::uint32_t i : candidates_)
+      if (std::abs(normal.x() * dx[i] + normal.y() * dy[i] + normal.z() * z[i] + d) <= params_.fit_tolerance)
+        inliers_.push_back(i);
+  }
+  return inliers_.size() >= min_points && pcaPlane(inliers_, dx, dy, z, normal, mean, &line);
+}
+
+bool GroundPlaneFitter::fitLowest(std::size_t k, const GroundPlane& predicted, float inner_from, float inner_radius,
+                                  const float* dx, const float* dy, const float* z, GroundFitStats& st)
+{
+  Eigen::Vector3d normal, mean;
+  bool line = false;
+  if (!lowestPlane(k, predicted, dx, dy, z, normal, mean, line))
+  {
+    ++st.few_points;
+    return false;
+  }
+  const double max_slope = params_.zones_max_slope_deg * kDegToRad;
+  GroundPlane plane;
+  if (line)
+  {
+    // Returns along one line (one lidar ring far away, a wall's foot): only their height is known; the plane keeps
+    // the predicted tilt.
+    plane = GroundPlane{ predicted.a, predicted.b,
+                         static_cast<float>(mean.z() - predicted.a * mean.x() - predicted.b * mean.y()) };
+  }
+  else
+  {
+    if (!(normal.z() >= std::max<double>(kMinNormalZ, std::cos(max_slope))))
+    {
+      ++st.too_steep;
+      return false;
+    }
+    plane = GroundPlane{ static_cast<float>(-normal.x() / normal.z()), static_cast<float>(-normal.y() / normal.z()),
+                         static_cast<float>(normal.dot(mean) / normal.z()) };
+  }
+  if (!continuesGround(plane, predicted, mean, inner_from, inner_radius, params_.search_band, max_slope))
+  {
+    ++st.discontinuous;
+    return false;
+  }
+  planes_[k] = plane;
+  return true;
 }
 
 }  // namespace core

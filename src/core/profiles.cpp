@@ -20,7 +20,7 @@ const std::vector<AddedStep>& addedSteps()
     { "deskew", "each point of a sweep moved to the sensor's pose at the cloud's stamp (clouds with a time field)",
       [](const Profile& p) { return p.scan_grid.deskew; },
       [](Profile& p) { p.scan_grid.deskew = false; } },
-    { "ground_model", "heights measured from RANSAC ground planes fitted per zone and scan, not from a flat ground",
+    { "ground_model", "heights measured from ground planes fitted per zone and scan (planes or zones), not from a flat ground",
       [](const Profile& p) { return p.scan_grid.groundModel() != GroundModel::kFlat; },
       [](Profile& p) { p.scan_grid.ground_model = toString(GroundModel::kFlat); } },
     { "relative_height", "a low obstacle return must stand obstacle_min_height above the lowest return around it",

@@ -130,10 +130,20 @@ struct PointPass
   float* valid_z;
   std::uint16_t* valid_zone;
   const GroundPlaneFitter* fitter;
+  // recordReturnClasses(): per point its class, per obstacle and valid return its point (nullptr when off).
+  ReturnClass* point_class;
+  std::uint32_t* obstacle_point;
+  std::uint32_t* valid_point;
 
-  /// Classifies a valid return at (dx, dy) from the sensor, height z, over ground height g, into @p out.
+  void record(std::size_t point, ReturnClass c) const
+  {
+    if (point_class) point_class[point] = c;
+  }
+
+  /// Classifies a valid return (point @p point of the view) at (dx, dy) from the sensor, height z, over ground
+  /// height g, into @p out.
   template <class Out>
-  void classify(float dx, float dy, float z, float r2, float g, Out& out) const
+  void classify(std::size_t point, float dx, float dy, float z, float r2, float g, Out& out) const
   {
     if (relative)
     {
@@ -152,9 +162,11 @@ struct PointPass
     if (h < -tolerance)
     {
       ++out.counts.below_ground;
+      record(point, ReturnClass::kBelowGround);
     }
     else if (h <= tolerance)
     {
+      record(point, ReturnClass::kGround);
       const std::size_t k = out.first + out.ground++;
       ground_sector[k] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
       ground_range2[k] = r2;
@@ -162,6 +174,7 @@ struct PointPass
     else if (h < obstacle_min)
     {
       ++out.counts.gap;
+      record(point, ReturnClass::kHeightGap);
     }
     else if (h <= obstacle_max)
     {
@@ -176,10 +189,16 @@ struct PointPass
       obstacle_xy[2 * k] = dx;
       obstacle_xy[2 * k + 1] = dy;
       if (relative) obstacle_z[k] = h < relative_limit ? z : kInfinity;
+      if (point_class)
+      {
+        point_class[point] = ReturnClass::kObstacle;
+        obstacle_point[k] = static_cast<std::uint32_t>(point);
+      }
     }
     else
     {
       ++out.counts.above;
+      record(point, ReturnClass::kAboveClearance);
     }
   }
 };
@@ -219,6 +238,7 @@ void ScanGridParams::validate() const
   groundModel();
   requireInRange("ground_sectors", ground_sectors, 1, kMaxGroundSectors);
   requireInRange("ground_max_slope_deg", ground_max_slope_deg, 0.0, kMaxGroundSlopeDeg);
+  requireInRange("ground_zones_max_slope_deg", ground_zones_max_slope_deg, 0.0, kMaxGroundSlopeDeg);
   requireInRange("ground_min_points", ground_min_points, 3, kMaxGroundMinPoints);
   if (!(ground_search_band > 0.0)) throw ParameterError("ground_search_band", "must be > 0");
   requireInRange("ground_search_band", ground_search_band, 0.0, kMaxGroundBand);
@@ -424,7 +444,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   pass.y_offset = points.y_offset;
   pass.z_offset = points.z_offset;
 
-  const bool planes = ground_kind_ == GroundModel::kPlanes;
+  const bool planes = ground_kind_ != GroundModel::kFlat;  // a fitted model: `planes` or `zones`
   pass.planes = planes;
   if (planes && valid_dx_.size() < n_points)
   {
@@ -438,6 +458,24 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const valid_z = pass.valid_z = valid_z_.data();
   std::uint16_t* const valid_zone = pass.valid_zone = valid_zone_.data();
   pass.fitter = &ground_;
+  pass.point_class = nullptr;
+  pass.obstacle_point = nullptr;
+  pass.valid_point = nullptr;
+  if (record_classes_)
+  {
+    // Every point starts rejected; classify() overwrites the valid returns.
+    return_classes_.assign(n_points, ReturnClass::kRejected);
+    obstacle_point_.resize(n_points + 1);
+    pass.point_class = return_classes_.data();
+    pass.obstacle_point = obstacle_point_.data();
+    if (planes)
+    {
+      valid_point_.resize(n_points + 1);
+      pass.valid_point = valid_point_.data();
+    }
+  }
+  else
+    return_classes_.clear();
   // The lists do not depend on the chunks (each chunk's returns are in point order, and chunks are joined in order),
   // so one thread takes all the points in one chunk, with nothing to move.
   const std::size_t chunk_points = pass.shared ? kPointChunk : std::max<std::size_t>(1, n_points);
@@ -503,9 +541,10 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         m.valid_dy[v] = dy;
         m.valid_z[v] = z;
         m.valid_zone[v] = static_cast<std::uint16_t>(m.fitter->zoneOf(r2, turnFraction(dx, dy)));
+        if (m.valid_point) m.valid_point[v] = static_cast<std::uint32_t>(k);
         continue;
       }
-      m.classify(dx, dy, z, r2, m.ground, out);
+      m.classify(k, dx, dy, z, r2, m.ground, out);
     }
     chunk_out[c] = out;
   });
@@ -520,6 +559,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     moveSegment(valid_dy, 1, out.first, out.valid, n_valid);
     moveSegment(valid_z, 1, out.first, out.valid, n_valid);
     moveSegment(valid_zone, 1, out.first, out.valid, n_valid);
+    if (pass.valid_point) moveSegment(pass.valid_point, 1, out.first, out.valid, n_valid);
     n_valid += out.valid;
   }
   std::size_t n_chunks = point_chunks;
@@ -538,7 +578,8 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       for (std::size_t i = v0; i < v1; ++i)
       {
         const float dx = m.valid_dx[i], dy = m.valid_dy[i];
-        m.classify(dx, dy, m.valid_z[i], dx * dx + dy * dy, m.fitter->plane(m.valid_zone[i]).at(dx, dy), out);
+        m.classify(m.valid_point ? m.valid_point[i] : 0, dx, dy, m.valid_z[i], dx * dx + dy * dy,
+                   m.fitter->plane(m.valid_zone[i]).at(dx, dy), out);
       }
       valid_out[c] = out;
     });
@@ -565,6 +606,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     moveSegment(obstacle_cell, 1, out.first, out.obstacle, n_obstacle);
     moveSegment(obstacle_xy, 2, out.first, out.obstacle, n_obstacle);
     if (relative) moveSegment(obstacle_z, 1, out.first, out.obstacle, n_obstacle);
+    if (pass.point_class) moveSegment(pass.obstacle_point, 1, out.first, out.obstacle, n_obstacle);
     n_ground += out.ground;
     n_obstacle += out.obstacle;
   }
@@ -589,9 +631,11 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         if (obstacle_z[k] - lowest < relief)
         {
           ++low_relief;
+          if (pass.point_class) pass.point_class[pass.obstacle_point[k]] = ReturnClass::kLowRelief;
           continue;
         }
       }
+      if (pass.point_class) pass.obstacle_point[kept] = pass.obstacle_point[k];
       obstacle_sector[kept] = obstacle_sector[k];
       obstacle_range2[kept] = obstacle_range2[k];
       obstacle_cell[kept] = cell;

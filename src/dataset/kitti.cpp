@@ -127,11 +127,12 @@ std::vector<double> readTimes(const std::string& path)
   return times;
 }
 
-KittiSequence::KittiSequence(const std::string& folder, std::size_t max_frames) : folder_(folder)
+KittiSequence::KittiSequence(const std::string& folder, std::size_t max_frames, const std::string& poses_file)
+  : folder_(folder)
 {
   if (!fs::is_directory(folder)) throw KittiError(folder + ": not a folder");
   const std::string times_path = (fs::path(folder) / "times.txt").string();
-  const std::string poses_path = (fs::path(folder) / "poses.txt").string();
+  const std::string poses_path = poses_file.empty() ? (fs::path(folder) / "poses.txt").string() : poses_file;
   const std::string calib_path = (fs::path(folder) / "calib.txt").string();
   times_ = readTimes(times_path);
   if (max_frames > 0 && times_.size() > max_frames) times_.resize(max_frames);

@@ -398,20 +398,25 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
   // Labelled sweeps: the decisions wait for the sweep's points (or the points for the decisions).
   std::map<std::int64_t, std::vector<eval::ClassGrid>> pending_decisions;
   std::map<std::int64_t, std::vector<eval::LabelledPoint>> pending_points;
+  // ... and what each variant's ScanGrid made of the sweep's points (its ground segmentation).
+  std::map<std::int64_t, std::vector<std::vector<core::ReturnClass>>> pending_classes;
   auto scorePending = [&](std::int64_t k) {
     auto d = pending_decisions.find(k);
     auto p = pending_points.find(k);
     if (d == pending_decisions.end() || p == pending_points.end()) return;
     const double t = static_cast<double>(k) * 1e-9;
+    const auto classes = pending_classes.find(k);
     for (std::size_t v = 0; v < variants.size(); ++v)
     {
       variants[v]->points.add(t, d->second[v], p->second, true);
+      if (classes != pending_classes.end()) variants[v]->points.addSegmentation(p->second, classes->second[v]);
       const auto& s = variants[v]->points.sweeps().back();
       csv << (t - *t0) << "," << variants[v]->scores.name << ",1," << s.v_cells << "," << s.false_v << ","
           << s.v_on_static << "," << s.mover_cells << "," << s.mover_v_cells << "\n";
     }
     pending_decisions.erase(d);
     pending_points.erase(p);
+    if (classes != pending_classes.end()) pending_classes.erase(classes);
   };
   rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{ "/points", "/ground_truth/points" }));
   for (const rosbag::MessageInstance& m : view)
@@ -474,6 +479,7 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
       if (!v->builder_ready)
       {
         v->builder.configure(v->scan_params, KittiConversions::toIsometry(sensor));
+        v->builder.recordReturnClasses(point_mode);
         v->builder_ready = true;
       }
       else
@@ -505,7 +511,10 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
       if (point_mode)
       {
         if (labelled)
+        {
           pending_decisions[k].push_back(v->decision);
+          pending_classes[k].push_back(v->builder.returnClasses());
+        }
         else
         {
           v->points.add(t, v->decision, {}, false);
@@ -550,7 +559,14 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
       {
         const fs::path dir = fs::path(opt.out) / "snapshots";
         const std::string stem = "sweep_" + std::to_string(sheet_frame++);
-        for (const auto& v : variants) writeSnapshotNpy(dir, stem + "_" + v->scores.name, v->decision);
+        for (const auto& v : variants)
+        {
+          writeSnapshotNpy(dir, stem + "_" + v->scores.name, v->decision);
+          // What the ScanGrid made of each point (core::ReturnClass codes, in the cloud's order), for the figures.
+          const auto& classes = v->builder.returnClasses();
+          if (v->scores.name == "default" || v->scores.name == "paper")
+            writeNpy(dir / (stem + "_" + v->scores.name + "_returns.npy"), classes.data(), { classes.size() }, "|u1");
+        }
         std::ofstream meta(dir / (stem + ".json"));
         const auto& g = variants[0]->grid.geometry();
         meta << "{\"time_s\": " << (t - *t0) << ", \"ego\": {\"x\": " << pose.x << ", \"y\": " << pose.y

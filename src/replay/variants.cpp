@@ -49,6 +49,16 @@ std::vector<VariantSpec> variantSpecs(const core::Profile& configured, bool have
     add("default_without_" + std::string(step.name),
         "default, without the step " + std::string(step.name) + ": " + std::string(step.summary), p, have_prior);
   }
+  // The ground model that is not the default's: its measurement beside the default's (doc/steps.md).
+  if (configured.scan_grid.groundModel() == core::GroundModel::kPlanes)
+  {
+    core::Profile p = configured;
+    p.scan_grid.ground_model = core::toString(core::GroundModel::kZones);
+    add("default_with_ground_zones",
+        "default, with the ground model `zones` (a least-squares plane per zone of a concentric zone model, from its "
+        "lowest returns) instead of `planes`",
+        p, have_prior);
+  }
   return specs;
 }
 

@@ -194,7 +194,10 @@ std::vector<eval::LabelledPoint> KittiConversions::toScoredPoints(const sensor_m
     eval::LabelledPoint lp;
     lp.p = core::Point2{ m.x(), m.y() };
     lp.state = static_cast<eval::LabelState>(p.state);
-    lp.obstacle = z >= obstacle_low && z <= obstacle_high && !dataset::isGroundClass(dataset::semanticClass(p.label));
+    const std::uint16_t semantic = dataset::semanticClass(p.label);
+    lp.ground = dataset::isGroundClass(semantic);
+    lp.vegetation = semantic == dataset::kClassVegetation;
+    lp.obstacle = z >= obstacle_low && z <= obstacle_high && !lp.ground;
     lp.instance = lp.state == eval::LabelState::kMoving ? p.label : 0;
     out.push_back(lp);
   }

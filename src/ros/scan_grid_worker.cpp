@@ -510,14 +510,14 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("deskew skipped in window", deskew_skipped_window_.count(now));
   for (const auto& d : deskew_counts_) status.add("deskew: " + d.first, d.second);
   status.add("ground model", params_.model.ground_model);
-  if (params_.model.groundModel() == core::GroundModel::kPlanes)
+  if (params_.model.groundModel() != core::GroundModel::kFlat)
   {
     const core::GroundFitStats& g = last_stats_.ground_fit;
     status.add("ground flat fallbacks in window", ground_fallback_window_.count(now));
     status.add("ground flat fallbacks", ground_flat_fallbacks_);
-    status.add("last cloud: ground zones fitted / few points / too steep",
+    status.add("last cloud: ground zones fitted / few points / too steep / discontinuous",
                std::to_string(g.fitted) + " / " + std::to_string(g.few_points) + " / " + std::to_string(g.too_steep) +
-                   " of " + std::to_string(g.zones));
+                   " / " + std::to_string(g.discontinuous) + " of " + std::to_string(g.zones));
   }
   status.add("reconfigure refused", reconfigure_refused_);
   status.add("last reconfigure", last_reconfigure_);

@@ -16,13 +16,15 @@ namespace {
 void usage()
 {
   std::cerr << "usage: kitti_to_bag --sequence DIR --out BAG [--frames N] [--start-stamp S] [--lidar-height M]\n"
-               "                    [--quiet]\n"
+               "                    [--poses FILE] [--quiet]\n"
                "  DIR is one KITTI odometry / SemanticKITTI sequence: velodyne/*.bin, labels/*.label (optional,\n"
                "  per frame), poses.txt, calib.txt (Tr), times.txt; or a KITTI tracking sequence in that layout with\n"
                "  label_02.txt and a P2 line in calib.txt (boxes with track ids: ground-truth objects with velocity\n"
                "  and motion state, and where the labels are valid). Writes BAG.partial and renames it to BAG when\n"
                "  every frame is written. --frames: the first N frames only. --start-stamp: ROS time of the\n"
-               "  sequence's time 0 (default 1317376800). --lidar-height: the velodyne above the ground (1.73 m).\n";
+               "  sequence's time 0 (default 1317376800). --lidar-height: the velodyne above the ground (1.73 m).\n"
+               "  --poses: camera-0 poses to use instead of DIR/poses.txt (same format; e.g. SemanticKITTI's\n"
+               "  poses of KITTI 00, lidar/kitti_00/poses_semantic_kitti.txt).\n";
 }
 
 double number(const std::string& name, const std::string& v)
@@ -46,6 +48,7 @@ int main(int argc, char** argv)
   std::string folder;
   KittiBagOptions options;
   std::size_t frames = 0;
+  std::string poses;
   bool quiet = false;
   try
   {
@@ -68,6 +71,7 @@ int main(int argc, char** argv)
       }
       else if (a == "--start-stamp") options.start_stamp = number(a, value());
       else if (a == "--lidar-height") options.lidar_height = number(a, value());
+      else if (a == "--poses") poses = value();
       else if (a == "--quiet") quiet = true;
       else if (a == "-h" || a == "--help")
       {
@@ -91,7 +95,7 @@ int main(int argc, char** argv)
   }
   try
   {
-    const dataset::KittiSequence sequence(folder, frames);
+    const dataset::KittiSequence sequence(folder, frames, poses);
     if (!quiet && ::isatty(STDERR_FILENO))
       options.progress = [](std::size_t done, std::size_t total) {
         std::fprintf(stderr, "\rkitti_to_bag: %zu/%zu frames", done, total);

@@ -224,15 +224,16 @@ struct P
   float x, y, z;
 };
 
-/// A ring-sampled ground surface z = g(x, y) from 2 to 60 m around the origin, one point every 2° and 0.5 m.
+/// A ring-sampled ground surface z = g(x, y) from 2 to 60 m around the origin, one point every 360° / @p azimuths
+/// and @p step metres (default: 2° and 0.5 m).
 template <class G>
-std::vector<P> groundSurface(G&& g)
+std::vector<P> groundSurface(G&& g, int azimuths = 180, double step = 0.5)
 {
   std::vector<P> pts;
-  for (double r = 2.0; r <= 60.0; r += 0.5)
-    for (int a = 0; a < 180; ++a)
+  for (double r = 2.0; r <= 60.0; r += step)
+    for (int a = 0; a < azimuths; ++a)
     {
-      const double t = 2.0 * kPi * a / 180.0;
+      const double t = 2.0 * kPi * a / azimuths;
       const float x = static_cast<float>(r * std::cos(t)), y = static_cast<float>(r * std::sin(t));
       pts.push_back({ x, y, static_cast<float>(g(x, y)) });
     }
@@ -258,6 +259,19 @@ ScanGridStats buildStats(const std::string& model, const std::vector<P>& pts, Sc
   EXPECT_TRUE(b.build(PointCloudView::packed(pts.data(), pts.size(), sizeof(P)), grid, &st));
   if (out) *out = b;
   return st;
+}
+
+/// Every plane of @p b is the 5 % grade of the graded-plane tests, and every return in range is ground.
+void expectGradedGround(const ScanGridBuilder& b, const ScanGridStats& st, std::size_t points)
+{
+  for (const GroundPlane& plane : b.groundModel().planes())
+  {
+    EXPECT_NEAR(plane.a, 0.05, 1e-3);
+    EXPECT_NEAR(plane.b, 0.0, 1e-3);
+    EXPECT_NEAR(plane.c, -1.8, 0.02);
+  }
+  EXPECT_EQ(st.ground, points - st.below_min_range - st.beyond_max_range);
+  EXPECT_EQ(st.obstacle, 0u);
 }
 
 }  // namespace
@@ -312,14 +326,7 @@ TEST(GroundModel, AGradedPlaneIsFoundInEveryZone)
   EXPECT_EQ(st.ground_fit.zones, static_cast<std::size_t>(kGroundRings * params.ground_sectors));
   EXPECT_EQ(st.ground_fit.fitted, st.ground_fit.zones);
   EXPECT_FALSE(st.ground_fit.flat_fallback);
-  for (const GroundPlane& plane : b.groundModel().planes())
-  {
-    EXPECT_NEAR(plane.a, 0.05, 1e-3);
-    EXPECT_NEAR(plane.b, 0.0, 1e-3);
-    EXPECT_NEAR(plane.c, -1.8, 0.02);
-  }
-  EXPECT_EQ(st.ground, pts.size() - st.below_min_range - st.beyond_max_range);
-  EXPECT_EQ(st.obstacle, 0u);
+  expectGradedGround(b, st, pts.size());
 }
 
 TEST(GroundModel, SlopeAndCamberBreakTheFlatModelNotThePlanes)
@@ -382,4 +389,85 @@ TEST(GroundModel, OnFlatGroundPlanesAndFlatAgree)
     EXPECT_EQ(b.groundModel().plane(z).a, again.groundModel().plane(z).a);
     EXPECT_EQ(b.groundModel().plane(z).c, again.groundModel().plane(z).c);
   }
+}
+
+TEST(GroundModel, ZonesParseAndLayTheConcentricZones)
+{
+  EXPECT_EQ(parseGroundModel("zones"), GroundModel::kZones);
+  EXPECT_STREQ(toString(GroundModel::kZones), "zones");
+  GroundModelParams p;
+  p.model = GroundModel::kZones;
+  GroundPlaneFitter f;
+  f.configure(p);
+  int zones = 0;
+  for (const int n : kZoneRingSectors) zones += n;
+  EXPECT_EQ(f.numZones(), zones);
+  EXPECT_EQ(f.numZones(), 504);
+  EXPECT_EQ(f.numRings(), static_cast<int>(kZoneRingSectors.size()));
+  // Ring edges: a return just inside 7.5 m is in ring 0, just outside in ring 1 (zone 16 on); the last ring has
+  // no outer edge; the azimuth picks the sector of the ring.
+  EXPECT_EQ(f.zoneOf(7.49f * 7.49f, 0.0f), 0);
+  EXPECT_EQ(f.zoneOf(7.51f * 7.51f, 0.0f), 16);
+  EXPECT_EQ(f.zoneOf(7.51f * 7.51f, 0.999f), 31);
+  EXPECT_EQ(f.zoneOf(12.5f * 12.5f, 0.5f), 32 + 16);
+  EXPECT_EQ(f.zoneOf(500.0f * 500.0f, 0.0f), 504 - 32);
+  // `planes` keeps its own layout.
+  p.model = GroundModel::kPlanes;
+  f.configure(p);
+  EXPECT_EQ(f.numZones(), kGroundRings * p.sectors);
+}
+
+TEST(GroundModel, ZonesFindAGradedPlaneWhereverThereAreReturns)
+{
+  const auto g = [](double x, double) { return 0.05 * x - 1.8; };
+  ScanGridParams params = groundParams("zones");
+  params.ground_height = -1.8;
+  ScanGridBuilder b(params, Eigen::Isometry3d::Identity());
+  const std::vector<P> pts = groundSurface(g, 720, 0.25);  // as dense as a 64-beam lidar's ground
+  ScanMassGrid grid;
+  ScanGridStats st;
+  ASSERT_TRUE(b.build(PointCloudView::packed(pts.data(), pts.size(), sizeof(P)), grid, &st));
+  EXPECT_EQ(st.ground_fit.zones, 504u);
+  // The surface reaches 60 m: the two outer rings (60.7 m on) hold no return and keep the predicted plane.
+  EXPECT_EQ(st.ground_fit.fitted, 504u - 64u);
+  EXPECT_EQ(st.ground_fit.few_points, 64u);
+  expectGradedGround(b, st, pts.size());
+}
+
+TEST(GroundModel, ZonesTakeAnEmbankmentAsGroundAndKeepABoxOnTheRoadAnObstacle)
+{
+  // A flat road, an embankment rising at 15° from 8 m to the left of it, and a 1.5 m high box 15 m ahead.
+  const double rise = std::tan(15.0 * kPi / 180.0);
+  const auto g = [rise](double, double y) { return y > 8.0 ? rise * (y - 8.0) : 0.0; };
+  std::vector<P> pts = groundSurface(g, 720, 0.25);
+  std::size_t embankment = 0;
+  for (const P& p : pts) embankment += p.y > 9.0f;
+  std::size_t box = 0;
+  for (float y = -1.0f; y <= 1.0f; y += 0.1f)
+    for (float z = 0.5f; z <= 1.5f; z += 0.25f, ++box) pts.push_back({ 15.0f, y, z });
+
+  const ScanGridStats planes = buildStats("planes", pts);
+  const ScanGridStats zones = buildStats("zones", pts);
+  // `planes` refuses planes steeper than 5°: most of the embankment stands above its predicted ground.
+  EXPECT_GT(planes.obstacle + planes.above_clearance, embankment / 2);
+  // `zones` follows it: the box and at most a tenth of the embankment (in the zones that hold its foot and the road:
+  // their lowest returns are the road's) remain.
+  EXPECT_GE(zones.obstacle, box - box / 5);
+  EXPECT_LE(zones.obstacle + zones.above_clearance, box + embankment / 10);
+}
+
+TEST(GroundModel, ZonesRefuseAFlatRoofThatDoesNotContinueTheGround)
+{
+  // A 4 × 8 m flat platform 1.5 m up from 14 m ahead (a truck's bed, a loading dock), nothing under it: the zones it
+  // covers fit a flat, level plane that starts 1.5 m above the ground inside them.
+  const auto g = [](double, double) { return 0.0; };
+  std::vector<P> pts;
+  for (const P& p : groundSurface(g, 720, 0.25))
+    if (!(p.x >= 14.0f && p.x <= 18.0f && std::fabs(p.y) <= 4.0f)) pts.push_back(p);
+  std::size_t platform = 0;
+  for (float x = 14.0f; x <= 18.0f; x += 0.1f)
+    for (float y = -4.0f; y <= 4.0f; y += 0.1f, ++platform) pts.push_back({ x, y, 1.5f });
+  const ScanGridStats zones = buildStats("zones", pts);
+  EXPECT_GE(zones.ground_fit.discontinuous, 1u);
+  EXPECT_EQ(zones.obstacle, platform);
 }

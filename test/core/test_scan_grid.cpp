@@ -1,6 +1,7 @@
 // ScanGrid sensor model on synthetic scans with hand-computed expected cells.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -737,6 +738,79 @@ TEST(ScanGrid, ManyChunksGiveTheSameGridForAnyThreadCount)
         EXPECT_EQ(st.occupied_cells, first.occupied_cells) << what;
         EXPECT_EQ(st.below_ground, first.below_ground) << what;
         EXPECT_EQ(st.ground_fit.fitted, first.ground_fit.fitted) << what;
+      }
+    }
+}
+
+TEST(ScanGrid, ReturnClassesNameWhatTheModelMadeOfEachPoint)
+{
+  ScanGridParams p = testParams();
+  p.min_range = 1.0;
+  ScanGridBuilder builder(p, Eigen::Isometry3d::Identity());
+  const std::vector<P> pts{
+    { 5.0f, 0.1f, 3.0f },    // above the clearance
+    { 5.0f, 0.2f, 0.25f },   // in the gap between the bands
+    { 5.0f, 0.3f, -0.5f },   // below the ground band
+    { 0.5f, 0.5f, 1.0f },    // below min range: rejected
+    { 31.0f, 0.0f, 1.0f },   // beyond max range: rejected
+    { 6.0f, -3.0f, 2.5f },   // obstacle
+    { 7.0f, 1.0f, 0.1f },    // ground
+    { kNaN, 1.0f, 0.0f },    // non-finite: rejected
+    { 0.0f, 0.0f, 0.0f },    // no return: rejected
+  };
+  const std::vector<ReturnClass> expected{ ReturnClass::kAboveClearance, ReturnClass::kHeightGap,
+                                           ReturnClass::kBelowGround,    ReturnClass::kRejected,
+                                           ReturnClass::kRejected,       ReturnClass::kObstacle,
+                                           ReturnClass::kGround,         ReturnClass::kRejected,
+                                           ReturnClass::kRejected };
+  ScanMassGrid grid;
+  ASSERT_TRUE(builder.build(view(pts), grid));
+  EXPECT_TRUE(builder.returnClasses().empty()) << "off by default";
+  const ScanMassGrid without = grid;
+  builder.recordReturnClasses(true);
+  ASSERT_TRUE(builder.build(view(pts), grid));
+  EXPECT_EQ(builder.returnClasses(), expected);
+  EXPECT_TRUE(samePlanes(grid, without)) << "recording changes nothing in the grid";
+}
+
+TEST(ScanGrid, ReturnClassesAgreeWithTheCountsForAnyModelAndThreadCount)
+{
+  const PaddedCloud cloud(64, 2100, 5);
+  for (const char* model : { "flat", "planes" })
+    for (double relative : { 0.0, 0.8 })
+    {
+      std::vector<ReturnClass> first;
+      for (int threads : { 1, 2 })
+      {
+        ScanGridParams params = chunkedParams();
+        params.ground_model = model;
+        params.relative_height_limit = relative;
+        params.threads = threads;
+        ScanGridBuilder builder(params, Eigen::Isometry3d::Identity());
+        builder.recordReturnClasses(true);
+        ScanMassGrid grid;
+        ScanGridStats st;
+        ASSERT_TRUE(builder.build(cloud.view(), grid, &st));
+        const auto& c = builder.returnClasses();
+        ASSERT_EQ(c.size(), st.points);
+        auto count = [&](ReturnClass r) { return static_cast<std::size_t>(std::count(c.begin(), c.end(), r)); };
+        const std::string what = std::string(model) + ", relative " + std::to_string(relative) + ", " +
+                                 std::to_string(threads) + " threads";
+        EXPECT_EQ(count(ReturnClass::kRejected), st.rejected()) << what;
+        EXPECT_EQ(count(ReturnClass::kGround), st.ground) << what;
+        EXPECT_EQ(count(ReturnClass::kObstacle), st.obstacle) << what;
+        EXPECT_EQ(count(ReturnClass::kBelowGround), st.below_ground) << what;
+        EXPECT_EQ(count(ReturnClass::kHeightGap), st.height_gap) << what;
+        EXPECT_EQ(count(ReturnClass::kAboveClearance), st.above_clearance) << what;
+        EXPECT_EQ(count(ReturnClass::kLowRelief), st.low_relief) << what;
+        if (relative > 0.0)
+        {
+          EXPECT_GT(st.low_relief, 0u) << what;
+        }
+        if (threads == 1)
+          first = c;
+        else
+          EXPECT_TRUE(c == first) << what << ": the classes differ between thread counts";
       }
     }
 }

@@ -104,6 +104,26 @@ TEST(Kitti, LidarPosesAreTrInverseTimesCameraPoseTimesTr)
   EXPECT_DOUBLE_EQ(s.time(2), 0.2);
 }
 
+TEST(Kitti, AnotherPoseFileReplacesTheFoldersPoses)
+{
+  Folder f("other_poses");
+  writeSequence(f);
+  // Camera 0 moving 2 m along its z per frame: the lidar 2 m along its x.
+  f.text("poses_other.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 2\n1 0 0 0 0 1 0 0 0 0 1 4\n");
+  const KittiSequence s(f.dir.string(), 0, (f.dir / "poses_other.txt").string());
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(s.lidarPose(k).translation().x(), 2.0 * k, 1e-12);
+  f.text("poses_short.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n");
+  try
+  {
+    KittiSequence short_poses(f.dir.string(), 0, (f.dir / "poses_short.txt").string());
+    FAIL() << "no error";
+  }
+  catch (const KittiError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("poses_short.txt"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Kitti, ConvertsToABagWithPointsTfAndLabelledPoints)
 {
   Folder f("bag");

@@ -87,7 +87,14 @@ TEST(ReplayVariants, TheConfiguredThePaperTheirAblationsAndOneRowPerAddedStep)
                                      "single_rate", "no_counter" };
   for (const core::AddedStep& step : core::addedSteps())
     if (step.enabled(configured)) expected.push_back("default_without_" + std::string(step.name));
+  expected.push_back("default_with_ground_zones");  // the ground model that is not the default's
   EXPECT_EQ(names, expected);
+  EXPECT_EQ(all.back().profile.scan_grid.groundModel(), core::GroundModel::kZones);
+  core::Profile zones = configured;
+  zones.scan_grid.ground_model = "zones";
+  zones.scan_grid.validate();
+  EXPECT_EQ(all.back().profile.scan_grid.groundModelParams().zones_max_slope_deg,
+            zones.scan_grid.groundModelParams().zones_max_slope_deg) << "only the model differs";
   EXPECT_TRUE(all[0].use_prior);
   EXPECT_FALSE(all[2].use_prior);
   for (const core::AddedStep& step : core::addedSteps())

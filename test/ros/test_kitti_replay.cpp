@@ -1,7 +1,8 @@
 // rostest test/kitti_replay.test: converts the real KITTI 00 frames (kitti_to_bag), replays them with
 // rosbag play --clock through the three nodelets (no map), records the live `decision` layer and scores it against
-// the SemanticKITTI point labels: false V per labelled sweep, the moving motorcyclist's cells decided V; and checks
-// that no moving track lies on the vehicle itself (its own body's returns, which move with it).
+// the SemanticKITTI point labels: false V per labelled sweep, the moving motorcyclist's cells decided V, labelled-ground
+// cells decided F, labelled-obstacle cells decided F, point-level moving IoU; and checks that no moving track lies on
+// the vehicle itself (its own body's returns, which move with it).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -128,7 +129,12 @@ TEST(KittiReplay, LiveDecisionsMeetTheMovingTargets)
               decisions.size(), sweeps, matched_labelled, s.at("v_cells_per_sweep"),
               s.at("false_v_per_labelled_sweep"), s.at("mover_cells_v_share"),
               s.at("mover_min_v_share_from_third_sweep"));
+  std::printf("kitti replay: labelled-ground cells F %.3f, labelled-obstacle cells F %.4f, moving IoU (points) %.3f\n",
+              s.at("ground_cells_f_recall"), s.at("obstacle_cells_false_free"), s.at("moving_point_iou"));
   ASSERT_GE(decisions.size(), sweeps - 1) << "the pipeline dropped scans";
+  EXPECT_GE(s.at("ground_cells_f_recall"), param("min_ground_cells_f_recall"));
+  EXPECT_LE(s.at("obstacle_cells_false_free"), param("max_obstacle_cells_false_free"));
+  EXPECT_GE(s.at("moving_point_iou"), param("min_moving_point_iou"));
   ASSERT_EQ(matched_labelled, labelled.size());
   EXPECT_LE(s.at("false_v_per_labelled_sweep"), param("max_false_v_per_labelled_sweep"));
   EXPECT_LE(s.at("v_cells_per_sweep"), param("max_v_cells_per_sweep"));

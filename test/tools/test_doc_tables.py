@@ -38,6 +38,26 @@ def write_held_out(path, default_movers):
                                 "paper": {"pooled": sim(0.5, 2), "drives": {"town_101": sim(0.5, 2)}}}}, f)
 
 
+REAL = ("kitti_00", "kitti_00_suma", "semantic_kitti_02", "semantic_kitti_06", "semantic_kitti_09",
+        "semantic_kitti_10")
+
+
+def real_variant(ground_f, ground, false_v=0, sweeps=10, tp=0, fp=0, fn=0, seg=(0, 0, 0)):
+    """A labelled real sequence's variant as `evaluate` writes it: ratios and the counts behind them."""
+    return {"labelled_sweeps": sweeps, "counts.ground_f_cells": ground_f, "counts.ground_cells": ground,
+            "counts.false_v": false_v, "counts.moving_tp": tp, "counts.moving_fp": fp, "counts.moving_fn": fn,
+            "counts.segmentation_tp": seg[0], "counts.segmentation_fp": seg[1], "counts.segmentation_fn": seg[2],
+            "counts.obstacle_cells": 1000, "counts.obstacle_f_cells": 1, "counts.mover_cells": 10,
+            "counts.mover_v_cells": 5, "counts.ground_as_obstacle": 0,
+            "ground_cells_f_recall": ground_f / ground if ground else -1}
+
+
+def write_real(out, default=None, paper=None):
+    for n in REAL:
+        write_metrics(str(out / "real" / n / "metrics.json"),
+                      {"default": default or real_variant(1, 2), "paper": paper or real_variant(0, 2)})
+
+
 def fake_readme(tmp):
     path = os.path.join(tmp, "README.md")
     with open(path, "w") as f:
@@ -54,8 +74,7 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     tracked = dict(sim(0.875, 4), movers_objects={"objects": [{"id": 5, "kind": "bus"}, {"id": 9, "kind": "car"}]},
                    tracks_objects=[track(9, 0.25, 0.2), track(5, 2.0, 0.8)])
     write_metrics(str(out / "metrics.json"), {"default": tracked, "paper": sim(0.5, 7)})
-    write_metrics(str(out / "kitti" / "metrics.json"),
-                  {"default": {"false_v_per_labelled_sweep": 2.5}, "paper": {"false_v_per_labelled_sweep": 140}})
+    write_real(out, default=real_variant(3, 4, false_v=25), paper=real_variant(1, 4, false_v=1400))
     write_metrics(str(out / "kitti_tracking" / "metrics.json"),
                   {"default": {"movers.all.detected_within_1s": 3, "movers.all.seen": 5, "tracks.mota": 0.853},
                    "paper": {"movers.all.detected_within_1s": 1, "movers.all.seen": 5}})
@@ -68,14 +87,16 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     text = open(readme).read()
     assert "| simulator | IoU F | 0.875 | 0.500 |" in text
     assert "| simulator | movers V ≤ 1 s | 4/11 | 7/11 |" in text
-    assert "| KITTI 00 | false V / labelled sweep | 2.5 | 140.0 |" in text
+    assert "| real sequences, pooled (5) | false V / labelled sweep | 2.5 | 140.0 |" in text
+    assert "| real sequences, pooled (5) | ground cells F | 0.750 | 0.250 |" in text
     assert "| KITTI tracking | movers V ≤ 1 s | 3/5 | 1/5 |" in text
     assert "| KITTI tracking | MOTA | 0.85 | – |" in text, "the paper has no tracks"
     assert "| held-out drives, pooled | movers V ≤ 1 s | 9/11 | 2/11 |" in text
     assert "| held-out drives, pooled | velocity RMSE (m/s) | 0.25 | – |" in text
     assert "old table" not in text and text.endswith("after\n")
     doc = open(tmp_path / "doc" / "results.md").read()
-    assert "## KITTI 00" in doc and "| default | 0.875 |" in doc
+    assert "## Labelled real sequences" in doc and "| default | 0.875 |" in doc
+    assert "| SemanticKITTI 10 | default | 2.5 |" in doc
     assert "| `town_101` (vlp32) | default | 0.750 |" in doc and "| pooled (1 drives) | paper | 0.500 |" in doc
     # The movers' velocity errors, the largest share of the squared error first; none for KITTI without tracks.
     assert "| 5 | bus | 10 | 9 | 1.00 | 9 | 2.00 | 1.50 | 0.80 |\n| 9 | car |" in doc
@@ -86,7 +107,7 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
 def test_docs_are_left_alone_without_the_held_out_drives(tmp_path):
     out = tmp_path / "out"
     write_metrics(str(out / "metrics.json"), {"default": sim(0.875, 4), "paper": sim(0.5, 7)})
-    write_metrics(str(out / "kitti" / "metrics.json"), {"default": {}, "paper": {}})
+    write_real(out)
     write_metrics(str(out / "kitti_tracking" / "metrics.json"), {"default": {}, "paper": {}})
     (tmp_path / "doc").mkdir()
     readme = fake_readme(str(tmp_path))
@@ -106,6 +127,31 @@ def test_docs_are_left_alone_without_the_real_datasets(tmp_path):
     assert "old table" in open(readme).read()
     assert not (tmp_path / "doc" / "results.md").exists()
     assert "| default | 0.875 |" in open(out / "results.md").read()
+
+
+def test_real_sequences_pool_by_summing_counts(tmp_path):
+    out = tmp_path / "out"
+    write_metrics(str(out / "metrics.json"), {"default": sim(0.875, 4), "paper": sim(0.5, 7)})
+    # Ground cells F: 1/1 on kitti_00, 1/3 on each SemanticKITTI sequence; kitti_00_suma (9/9) is not pooled.
+    # Pooled: (1 + 4 × 1) / (1 + 4 × 3) = 5/13, not the mean of the ratios. Moving IoU: TP 2, FP 1, FN 1 each.
+    for n in REAL:
+        ground_f, ground = (1, 1) if n == "kitti_00" else (9, 9) if n == "kitti_00_suma" else (1, 3)
+        write_metrics(str(out / "real" / n / "metrics.json"),
+                      {"default": real_variant(ground_f, ground, tp=2, fp=1, fn=1, seg=(90, 5, 5)),
+                       "paper": real_variant(0, ground), "default_without_x": real_variant(0, 1)})
+    run(str(out))
+    pooled = json.load(open(out / "real" / "pooled.json"))
+    assert pooled["sequences"] == ["kitti_00", "semantic_kitti_02", "semantic_kitti_06", "semantic_kitti_09",
+                                   "semantic_kitti_10"]
+    c = pooled["variants"]["default"]["counts"]
+    assert (c["ground_f_cells"], c["ground_cells"]) == (5, 13)
+    assert c["ground_points"] == 5 * 95
+    text = open(out / "results.md").read()
+    assert f"| **pooled** (5 drives) | default | 0.0 | 0.50 | 0.500 | {5 / 13:.3f} |" in text
+    assert "| default_without_x |" in text, "every variant on the pooled sequences"
+    summary = open(out / "results_summary.md").read()
+    assert f"| real sequences, pooled (5) | ground cells F | {5 / 13:.3f} | 0.000 |" in summary
+    assert "| real sequences, pooled (5) | ground F1 (points) | 0.947 | – |" in summary
 
 
 def test_checked_in_readme_shows_the_summary_of_doc_results():

@@ -42,6 +42,7 @@
 #include "map_aided_fusion/core/ground_model.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
 #include "map_aided_fusion/core/parallel.hpp"
+#include "map_aided_fusion/core/return_class.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -104,13 +105,16 @@ struct ScanGridParams
   bool deskew = true;
   double deskew_max_sweep_duration = 0.2;  ///< s, a point time beyond this after the stamp skips deskewing, (0, 10]
 
-  /// Step "ground model" (not in the paper): `flat` (z = ground_height) or `planes` (core/ground_model.hpp).
+  /// Step "ground model" (not in the paper): `flat` (z = ground_height), `planes` (a RANSAC plane per zone of 4
+  /// rings × ground_sectors) or `zones` (a least-squares plane per zone of a concentric zone model of 504 zones from
+  /// its lowest returns; core/ground_model.hpp).
   std::string ground_model = "planes";
   int ground_sectors = 8;               ///< azimuth sectors per ring of the `planes` model, in [1, 64]
   double ground_max_slope_deg = 5.0;    ///< a fitted plane steeper than this (against the body) is refused, deg, [0, 60]
   int ground_min_points = 20;           ///< candidates and inliers a zone's fit needs, in [3, 100000]
   double ground_search_band = 0.6;      ///< m, a zone's candidates lie within this of the predicted ground, (0, 10]
-  double ground_fit_tolerance = 0.08;   ///< m, RANSAC inlier distance, (0, ground_search_band]
+  double ground_fit_tolerance = 0.08;   ///< m, RANSAC (`zones`: least-squares) inlier distance, (0, ground_search_band]
+  double ground_zones_max_slope_deg = 20.0;  ///< `zones`: a steeper zone plane is refused, deg, [0, 60]
 
   /**
    * Threads of build(), in [0, kMaxThreads]; 0: every core. The grid, the obstacle returns and the counts are
@@ -123,8 +127,8 @@ struct ScanGridParams
   /// The `planes` model's parameters.
   GroundModelParams groundModelParams() const
   {
-    return GroundModelParams{ ground_sectors,     ground_max_slope_deg, ground_min_points,
-                              ground_search_band, ground_fit_tolerance, ground_height };
+    return GroundModelParams{ ground_sectors,       ground_max_slope_deg, ground_min_points, ground_search_band,
+                              ground_fit_tolerance, ground_height,        groundModel(), ground_zones_max_slope_deg };
   }
 
   /// The grid described by the grid_* parameters.
@@ -167,12 +171,13 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("relative_height_limit", p.relative_height_limit, { "m", "step: a low obstacle return must stand obstacle_min_height above the lowest return around it; 0: off" });
   get("deskew", p.deskew, { "", "step: clouds with a per-point time field are moved to the sensor pose at the stamp" });
   get("deskew_max_sweep_duration", p.deskew_max_sweep_duration, { "s", "a point time beyond this after the stamp skips deskewing" });
-  get("ground_model", p.ground_model, { "", "flat (z = ground_height) or planes (RANSAC planes per zone and scan)" });
-  get("ground_sectors", p.ground_sectors, { "", "azimuth sectors per ring of the planes model" });
+  get("ground_model", p.ground_model, { "", "flat (z = ground_height), planes (RANSAC planes per zone and scan) or zones (region-wise planes from the lowest returns, 504 zones)" });
+  get("ground_sectors", p.ground_sectors, { "", "azimuth sectors per ring of the planes model (zones: fixed layout)" });
   get("ground_max_slope_deg", p.ground_max_slope_deg, { "deg", "a fitted plane steeper than this against the body is refused" });
   get("ground_min_points", p.ground_min_points, { "returns", "candidates and inliers a zone's fit needs" });
   get("ground_search_band", p.ground_search_band, { "m", "a zone's candidates lie within this of the predicted ground" });
-  get("ground_fit_tolerance", p.ground_fit_tolerance, { "m", "RANSAC inlier distance" });
+  get("ground_fit_tolerance", p.ground_fit_tolerance, { "m", "RANSAC (zones: least-squares) inlier distance" });
+  get("ground_zones_max_slope_deg", p.ground_zones_max_slope_deg, { "deg", "zones model: a zone plane steeper than this against the body is refused (an embankment is ground, a wall is not)" });
   get("threads", p.threads, { "", "threads of the ScanGrid builder; 0: every core (results identical for any value)" });
 }
 
@@ -266,6 +271,15 @@ public:
    */
   ObstaclePoints obstaclePoints() const { return ObstaclePoints{ obstacle_points_.data(), obstacle_count_ }; }
 
+  /**
+   * @brief Keep, from the next build() on, what the sensor model made of each point (returnClasses()). Off by
+   *        default: scoring tools turn it on (a labelled sweep's points against the model's ground); the grid
+   *        built is the same either way.
+   */
+  void recordReturnClasses(bool on) { record_classes_ = on; }
+  /// With recordReturnClasses(true): one class per point of the last build()'s view, in the view's order.
+  const std::vector<ReturnClass>& returnClasses() const { return return_classes_; }
+
   bool configured() const { return configured_; }
   const ScanGridParams& params() const { return params_; }
   const GridGeometry& geometry() const { return geometry_; }
@@ -316,6 +330,11 @@ private:
   std::size_t obstacle_count_ = 0;
   std::vector<float> obstacle_z_;
   std::vector<float> cell_min_z_;
+  // recordReturnClasses(): the class of each point, and the point index of each obstacle and valid return.
+  bool record_classes_ = false;
+  std::vector<ReturnClass> return_classes_;
+  std::vector<std::uint32_t> obstacle_point_;
+  std::vector<std::uint32_t> valid_point_;
   // The `planes` ground model: the valid returns (relative to the sensor) and their zones, then the fitter.
   GroundModel ground_kind_ = GroundModel::kFlat;
   std::vector<float> valid_dx_, valid_dy_, valid_z_;
@@ -349,6 +368,7 @@ private:
   };
   std::vector<ChunkReturns> chunk_returns_, valid_returns_;
   std::vector<std::size_t> sector_chunk_free_;
+
 };
 
 }  // namespace core

@@ -42,6 +42,7 @@ enum class PointState : std::uint8_t
 /// SemanticKITTI classes (low 16 bits of a label).
 constexpr std::uint16_t kClassUnlabeled = 0;
 constexpr std::uint16_t kClassOutlier = 1;
+constexpr std::uint16_t kClassVegetation = 70;
 constexpr std::uint16_t kFirstMovingClass = 252;
 constexpr std::uint16_t kLastMovingClass = 259;
 
@@ -68,9 +69,10 @@ public:
    * @brief Opens and checks @p folder: times.txt, poses.txt and calib.txt parse, there is a pose and a time
    *        per scan, velodyne/ holds frames 0 … N−1 without a gap.
    * @param max_frames  read at most this many frames (0: all)
+   * @param poses_path  a poses.txt to read instead of the folder's (empty: `folder`/poses.txt)
    * @throws KittiError naming the file (and line) at fault.
    */
-  explicit KittiSequence(const std::string& folder, std::size_t max_frames = 0);
+  explicit KittiSequence(const std::string& folder, std::size_t max_frames = 0, const std::string& poses_path = "");
 
   std::size_t size() const { return times_.size(); }
   const std::string& folder() const { return folder_; }
