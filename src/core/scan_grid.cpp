@@ -130,6 +130,8 @@ struct PointPass
   float* valid_z;
   std::uint16_t* valid_zone;
   const GroundPlaneFitter* fitter;
+  // Step "ambiguous unknown": per cell, set when it holds a return neither ground nor obstacle (nullptr when off).
+  std::uint8_t* ambiguous;
   // recordReturnClasses(): per point its class, per obstacle and valid return its point (nullptr when off).
   ReturnClass* point_class;
   std::uint32_t* obstacle_point;
@@ -138,6 +140,16 @@ struct PointPass
   void record(std::size_t point, ReturnClass c) const
   {
     if (point_class) point_class[point] = c;
+  }
+
+  /// Flags the cell of a return at (dx, dy) from the sensor as holding an ambiguous return (any thread).
+  void markAmbiguous(float dx, float dy) const
+  {
+    const float fx = cx0 + dx * inv_res;
+    const float fy = cy0 + dy * inv_res;
+    if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
+      __atomic_store_n(ambiguous + static_cast<int>(fy) * width + static_cast<int>(fx), std::uint8_t{ 1 },
+                       __ATOMIC_RELAXED);
   }
 
   /// Classifies a valid return (point @p point of the view) at (dx, dy) from the sensor, height z, over ground
@@ -175,6 +187,7 @@ struct PointPass
     {
       ++out.counts.gap;
       record(point, ReturnClass::kHeightGap);
+      if (ambiguous) markAmbiguous(dx, dy);
     }
     else if (h <= obstacle_max)
     {
@@ -458,6 +471,12 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const valid_z = pass.valid_z = valid_z_.data();
   std::uint16_t* const valid_zone = pass.valid_zone = valid_zone_.data();
   pass.fitter = &ground_;
+  pass.ambiguous = nullptr;
+  if (params_.ambiguous_unknown)
+  {
+    ambiguous_.assign(geometry_.numCells(), 0);
+    pass.ambiguous = ambiguous_.data();
+  }
   pass.point_class = nullptr;
   pass.obstacle_point = nullptr;
   pass.valid_point = nullptr;
@@ -632,6 +651,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         {
           ++low_relief;
           if (pass.point_class) pass.point_class[pass.obstacle_point[k]] = ReturnClass::kLowRelief;
+          if (pass.ambiguous) pass.ambiguous[cell] = 1;
           continue;
         }
       }
@@ -716,6 +736,18 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   });
   std::size_t free_cells = 0;
   for (const std::size_t c : sector_chunk_free_) free_cells += c;
+  if (pass.ambiguous)
+  {
+    // Step "ambiguous unknown": a cell holding a return that is neither ground nor obstacle is not free.
+    const std::uint8_t* const amb = pass.ambiguous;
+    for (std::size_t i = 0; i < n; ++i)
+      if (amb[i] && m_f[i] > 0.0f)
+      {
+        m_f[i] = 0.0f;
+        m_omega[i] = 1.0f;
+        --free_cells;
+      }
+  }
 
   const float mu_o = static_cast<float>(params_.mu_occupied);
   std::size_t occupied = 0;

@@ -49,6 +49,7 @@ void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
   c.mu_occupied = m.mu_occupied;
   c.free_decay_length = m.free_decay_length;
   c.free_margin = m.free_margin;
+  c.ambiguous_unknown = m.ambiguous_unknown;
   c.deskew = m.deskew;
   c.ground_model = m.ground_model;
 }
@@ -415,6 +416,7 @@ void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level
   m.mu_occupied = config.mu_occupied;
   m.free_decay_length = config.free_decay_length;
   m.free_margin = config.free_margin;
+  m.ambiguous_unknown = config.ambiguous_unknown;
   m.deskew = config.deskew;
   m.ground_model = config.ground_model;
   try

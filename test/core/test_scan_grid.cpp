@@ -40,6 +40,7 @@ ScanGridParams testParams()
   p.mu_free = 0.7;
   p.mu_occupied = 0.8;
   p.relative_height_limit = 0.0;  // the paper's sensor model; the steps have their own tests
+  p.ambiguous_unknown = false;
   p.ground_model = "flat";
   return p;
 }
@@ -813,4 +814,60 @@ TEST(ScanGrid, ReturnClassesAgreeWithTheCountsForAnyModelAndThreadCount)
           EXPECT_TRUE(c == first) << what << ": the classes differ between thread counts";
       }
     }
+}
+
+TEST(ScanGrid, AmbiguousReturnsLeaveTheirCellUnknownNotFree)
+{
+  ScanGridParams p = testParams();
+  p.azimuth_resolution_deg = 10.0;  // sector [0°, 10°) holds the centres of row 40 from column 43 on
+  const int row = 40;
+  // Ground out to 12.25 m; a return in the gap between the bands at 5.25 m (cell 50), one at 8.25 m (cell 56).
+  const std::vector<P> pts{ { 12.25f, 0.1f, 0.0f }, { 5.25f, 0.05f, 0.25f }, { 8.25f, 0.05f, 0.27f } };
+  ScanMassGrid off, on;
+  ScanGridStats st_off, st_on;
+  ScanGridBuilder builder(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pts), off, &st_off));
+  for (int x = 43; x <= 63; ++x) expectFree(off, x, row);
+  p.ambiguous_unknown = true;
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pts), on, &st_on));
+  for (int x = 43; x <= 63; ++x)
+    if (x == 50 || x == 56)
+      expectUnknown(on, x, row);
+    else
+      expectFree(on, x, row);
+  EXPECT_EQ(st_on.free_cells, st_off.free_cells - 2);
+  EXPECT_EQ(st_on.height_gap, 2u);
+
+  // Returns the relative obstacle height drops (a raised pavement) are ambiguous too; an obstacle stays occupied.
+  std::vector<P> pavement;
+  for (float x = 8.0f; x < 10.0f; x += 0.25f)
+    for (float y = 0.05f; y <= 0.45f; y += 0.2f) pavement.push_back({ x, y, 0.4f });
+  pavement.push_back({ 14.25f, 0.1f, 0.0f });  // ground beyond it
+  pavement.push_back({ 6.25f, 0.05f, 1.0f });  // an obstacle before it: the sector's free space ends there
+  p.relative_height_limit = 0.8;
+  p.ambiguous_unknown = false;
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pavement), off, &st_off));
+  p.ambiguous_unknown = true;
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pavement), on, &st_on));
+  EXPECT_GT(st_on.low_relief, 0u);
+  EXPECT_TRUE(samePlanes(on, off)) << "the pavement lies behind the obstacle: nothing free to take back";
+  expectOccupied(on, 52, row);
+  pavement.pop_back();  // without the obstacle the ground at 14.25 m frees the sector through the pavement
+  p.ambiguous_unknown = false;
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pavement), off, &st_off));
+  p.ambiguous_unknown = true;
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pavement), on, &st_on));
+  for (int x = 56; x <= 59; ++x)
+  {
+    expectFree(off, x, row);
+    expectUnknown(on, x, row);  // centres 8.25 … 9.75: the pavement's cells
+  }
+  expectFree(on, 55, row);
+  expectFree(on, 60, row);
+  EXPECT_EQ(on.plane(FrameSG::kO)[on.geometry().index(56, row)], 0.0f) << "ambiguous, not occupied";
 }

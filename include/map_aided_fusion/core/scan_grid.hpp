@@ -97,6 +97,12 @@ struct ScanGridParams
    * return around it).
    */
   double relative_height_limit = 0.8;
+  /**
+   * Step "ambiguous unknown" (not in the paper): a cell holding a return that is neither ground nor obstacle (in the
+   * gap between the ground band and the obstacle band, or dropped by the relative obstacle height) gets no free mass:
+   * what the sensor model cannot call ground or obstacle is unknown, not free.
+   */
+  bool ambiguous_unknown = true;
 
   /**
    * Step "deskew" (not in the paper): clouds whose points carry a time field are moved to the sensor's pose at
@@ -169,6 +175,7 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("free_decay_length", p.free_decay_length, { "m", "μ_F(r) = μ_F·exp(−r / L); 0: no decay" });
   get("free_margin", p.free_margin, { "m", "cells nearer than this to a sector's first obstacle stay unknown rather than free" });
   get("relative_height_limit", p.relative_height_limit, { "m", "step: a low obstacle return must stand obstacle_min_height above the lowest return around it; 0: off" });
+  get("ambiguous_unknown", p.ambiguous_unknown, { "", "step: a cell holding a return neither ground nor obstacle gets no free mass" });
   get("deskew", p.deskew, { "", "step: clouds with a per-point time field are moved to the sensor pose at the stamp" });
   get("deskew_max_sweep_duration", p.deskew_max_sweep_duration, { "s", "a point time beyond this after the stamp skips deskewing" });
   get("ground_model", p.ground_model, { "", "flat (z = ground_height), planes (RANSAC planes per zone and scan) or zones (region-wise planes from the lowest returns, 504 zones)" });
@@ -333,6 +340,7 @@ private:
   // recordReturnClasses(): the class of each point, and the point index of each obstacle and valid return.
   bool record_classes_ = false;
   std::vector<ReturnClass> return_classes_;
+  std::vector<std::uint8_t> ambiguous_;  // step "ambiguous unknown": per cell, holds an ambiguous return
   std::vector<std::uint32_t> obstacle_point_;
   std::vector<std::uint32_t> valid_point_;
   // The `planes` ground model: the valid returns (relative to the sensor) and their zones, then the fitter.
