@@ -113,6 +113,8 @@ REAL_COLUMNS = [
     ("ground cells F", lambda v: counted(v, "ground_f_cells", "ground_cells")),
     ("ground cells F, settled", lambda v: counted(v, "ground_f_cells_settled", "ground_cells_settled")),
     ("obstacle cells F (%)", lambda v: counted(v, "obstacle_f_cells", "obstacle_cells", 3, 100.0)),
+    ("obstacle cells F, vegetation left out (%)", lambda v: counted(v, "rigid_f_cells", "rigid_cells", 3, 100.0)),
+    ("movers' cells S", lambda v: counted(v, "mover_s_cells", "mover_cells", 3)),
     ("ground F1 (points)", f1),
     ("ground returns called obstacle", lambda v: counted(v, "ground_as_obstacle", "ground_points")),
 ]
@@ -250,7 +252,7 @@ def summary(sim, real_pooled, tracking, held=None):
         cols = dict(REAL_COLUMNS)
         data = f"real sequences, pooled ({next(iter(real_pooled.values()))['sequences']})"
         for title in ("false V / labelled sweep", "movers' cells V", "moving IoU (points)", "ground cells F",
-                      "obstacle cells F (%)", "ground F1 (points)"):
+                      "obstacle cells F (%)", "obstacle cells F, vegetation left out (%)", "ground F1 (points)"):
             add(data, real_pooled, title, cols[title])
     cols = dict(TRACKING_COLUMNS)
     for title in ("movers V ≤ 1 s", "movers' mean V share", "movers' cells S", "false V / scan", "MOTA"):

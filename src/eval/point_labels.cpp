@@ -77,7 +77,7 @@ void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPo
   const core::GridGeometry& g = decision.geometry;
   const auto moving = static_cast<std::int8_t>(core::CellClass::kMoving);
   const auto free = static_cast<std::int8_t>(core::CellClass::kFree);
-  std::unordered_set<std::size_t> ground, other, obstacle;
+  std::unordered_set<std::size_t> ground, other, obstacle, rigid;
   for (const LabelledPoint& lp : points)
   {
     if (lp.state == LabelState::kUnlabelled) continue;
@@ -92,6 +92,7 @@ void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPo
     const std::size_t i = g.index(c);
     (lp.ground ? ground : other).insert(i);
     if (lp.obstacle) obstacle.insert(i);
+    if (lp.obstacle && !lp.vegetation) rigid.insert(i);
   }
   for (std::size_t i : ground)
     if (!other.count(i))
@@ -103,6 +104,11 @@ void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPo
   {
     ++s.obstacle_cells;
     s.obstacle_f_cells += decision.cells[i] == free;
+  }
+  for (std::size_t i : rigid)
+  {
+    ++s.rigid_cells;
+    s.rigid_f_cells += decision.cells[i] == free;
   }
 }
 
@@ -154,10 +160,12 @@ void PointLabelScorer::add(double stamp, const ClassGrid& decision, const std::v
     if (!near_moving.count(i)) ++s.false_v;
     if (static_cells.count(i) && !moving_cells.count(i)) ++s.v_on_static;
   }
+  const auto stopped = static_cast<std::int8_t>(core::CellClass::kStopped);
   for (std::size_t i : moving_cells)
   {
     ++s.mover_cells;
     s.mover_v_cells += decision.cells[i] == moving;
+    s.mover_s_cells += decision.cells[i] == stopped;
   }
   for (std::size_t i : static_cells)
     if (!moving_cells.count(i)) ++s.static_cells[static_cast<std::size_t>(slotOf(decision.cells[i]))];
@@ -235,7 +243,7 @@ std::map<std::string, double> PointLabelScorer::summary() const
 void PointLabelScorer::addCellAndPointScores(std::map<std::string, double>& m) const
 {
   double ground = 0, ground_f = 0, ground_settled = 0, ground_f_settled = 0, obstacle = 0, obstacle_f = 0;
-  double tp = 0, fp = 0, fn = 0, false_v = 0, mover = 0, mover_v = 0;
+  double rigid = 0, rigid_f = 0, tp = 0, fp = 0, fn = 0, false_v = 0, mover = 0, mover_v = 0, mover_s = 0;
   for (const PointScanScore& s : sweeps_)
   {
     if (!s.labelled) continue;
@@ -248,6 +256,9 @@ void PointLabelScorer::addCellAndPointScores(std::map<std::string, double>& m) c
     }
     obstacle += static_cast<double>(s.obstacle_cells);
     obstacle_f += static_cast<double>(s.obstacle_f_cells);
+    rigid += static_cast<double>(s.rigid_cells);
+    rigid_f += static_cast<double>(s.rigid_f_cells);
+    mover_s += static_cast<double>(s.mover_s_cells);
     tp += static_cast<double>(s.moving_tp);
     fp += static_cast<double>(s.moving_fp);
     fn += static_cast<double>(s.moving_fn);
@@ -258,12 +269,15 @@ void PointLabelScorer::addCellAndPointScores(std::map<std::string, double>& m) c
   m["ground_cells_f_recall"] = countRatio(ground_f, ground);
   m["ground_cells_f_recall_settled"] = countRatio(ground_f_settled, ground_settled);
   m["obstacle_cells_false_free"] = countRatio(obstacle_f, obstacle);
+  m["rigid_cells_false_free"] = countRatio(rigid_f, rigid);
+  m["mover_cells_s_share"] = countRatio(mover_s, mover);
   m["moving_point_iou"] = countRatio(tp, tp + fp + fn);
   const std::map<std::string, double> counts{
     { "ground_cells", ground },       { "ground_f_cells", ground_f },     { "ground_cells_settled", ground_settled },
     { "ground_f_cells_settled", ground_f_settled }, { "obstacle_cells", obstacle }, { "obstacle_f_cells", obstacle_f },
     { "moving_tp", tp },              { "moving_fp", fp },                { "moving_fn", fn },
     { "false_v", false_v },           { "mover_cells", mover },           { "mover_v_cells", mover_v },
+    { "mover_s_cells", mover_s },     { "rigid_cells", rigid },           { "rigid_f_cells", rigid_f },
   };
   for (const auto& [k, v] : counts) m["counts." + k] = v;
   if (!scoresSegmentation()) return;
@@ -309,9 +323,10 @@ std::string pointLabelMarkdown(const std::vector<std::pair<std::string, const Po
       << std::setprecision(1) << (rows.empty() ? PointLabelScorer::kDefaultSettleTime : rows.front().second->settleTime())
       << " s on), labelled-obstacle cells decided F, the ScanGrid's point-level ground segmentation, point-level "
          "moving IoU.\n\n";
-  out << "| variant | ground cells F | ground cells F (settled) | obstacle cells F | ground precision | ground recall "
-         "| ground F1 | ground returns called obstacle | moving IoU (points) |\n";
-  out << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  out << "| variant | ground cells F | ground cells F (settled) | obstacle cells F | obstacle cells F, vegetation left "
+         "out | ground precision | ground recall | ground F1 | ground returns called obstacle | moving IoU (points) | "
+         "mover cells S |\n";
+  out << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const auto& [name, scorer] : rows)
   {
     const auto m = scorer->summary();
@@ -323,9 +338,10 @@ std::string pointLabelMarkdown(const std::vector<std::pair<std::string, const Po
       return s.str();
     };
     out << "| " << name << " | " << f("ground_cells_f_recall", 3) << " | " << f("ground_cells_f_recall_settled", 3)
-        << " | " << f("obstacle_cells_false_free", 4) << " | " << f("ground_segmentation.precision", 3) << " | "
-        << f("ground_segmentation.recall", 3) << " | " << f("ground_segmentation.f1", 3) << " | "
-        << f("ground_segmentation.ground_as_obstacle", 3) << " | " << f("moving_point_iou", 3) << " |\n";
+        << " | " << f("obstacle_cells_false_free", 4) << " | " << f("rigid_cells_false_free", 4) << " | "
+        << f("ground_segmentation.precision", 3) << " | " << f("ground_segmentation.recall", 3) << " | "
+        << f("ground_segmentation.f1", 3) << " | " << f("ground_segmentation.ground_as_obstacle", 3) << " | "
+        << f("moving_point_iou", 3) << " | " << f("mover_cells_s_share", 3) << " |\n";
   }
   return out.str();
 }

@@ -68,6 +68,27 @@ TEST(PointLabels, GroundCellsHoldGroundPointsAndNoOtherLabelledPoint)
   EXPECT_DOUBLE_EQ(m.at("counts.obstacle_f_cells"), 1.0);
 }
 
+TEST(PointLabels, VegetationIsAnObstacleButScoredApartAndMoversCellsSAreCounted)
+{
+  eval::PointLabelScorer s(1.0);
+  // Cell 0 (F): vegetation only. Cell 1 (F): a static obstacle. Cell 2 (V): a mover. Cell 3 (S): a mover.
+  std::vector<LabelledPoint> pts{ point(0.5, LabelState::kStatic, false, true, true), obstacle(1.5), mover(2.5),
+                                  mover(3.5) };
+  s.add(0.0, row({ kF, kF, kV, kS }), pts, true);
+  const auto& w = s.sweeps().back();
+  EXPECT_EQ(w.obstacle_cells, 4u);
+  EXPECT_EQ(w.obstacle_f_cells, 2u);
+  EXPECT_EQ(w.rigid_cells, 3u);
+  EXPECT_EQ(w.rigid_f_cells, 1u);
+  EXPECT_EQ(w.mover_cells, 2u);
+  EXPECT_EQ(w.mover_s_cells, 1u);
+  const auto m = s.summary();
+  EXPECT_DOUBLE_EQ(m.at("obstacle_cells_false_free"), 0.5);
+  EXPECT_DOUBLE_EQ(m.at("rigid_cells_false_free"), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(m.at("mover_cells_s_share"), 0.5);
+  EXPECT_DOUBLE_EQ(m.at("counts.mover_s_cells"), 1.0);
+}
+
 TEST(PointLabels, MovingIoUCountsPointsByTheirCellsDecision)
 {
   eval::PointLabelScorer s(1.0);

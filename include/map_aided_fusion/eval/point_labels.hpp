@@ -56,6 +56,9 @@ struct PointScanScore
   std::uint64_t ground_f_cells = 0;  ///< of those, decided F
   std::uint64_t obstacle_cells = 0;  ///< cells holding a labelled obstacle point (static or moving)
   std::uint64_t obstacle_f_cells = 0;  ///< of those, decided F (false free)
+  std::uint64_t rigid_cells = 0;     ///< cells holding a labelled obstacle point that is not vegetation
+  std::uint64_t rigid_f_cells = 0;   ///< of those, decided F
+  std::uint64_t mover_s_cells = 0;   ///< cells holding a moving obstacle point, decided S (stopped)
   /// Points (unlabelled left out): moving and in a V cell, static in a V cell, moving elsewhere. Static points of a
   /// ground class are left out of moving_fp: the ground under a mover shares its cells in a 2-D grid.
   std::uint64_t moving_tp = 0, moving_fp = 0, moving_fn = 0;
@@ -123,7 +126,9 @@ public:
    *        "movers", "movers_never_v", "static_cells.{F,C,N,S,V,unknown}" (shares of static obstacle cells);
    *        "ground_cells_f_recall" (labelled-ground cells decided F, pooled over the labelled sweeps; −1 when none),
    *        "ground_cells_f_recall_settled" (the same from settleTime() after the first sweep on),
-   *        "obstacle_cells_false_free" (labelled-obstacle cells decided F), "moving_point_iou" (points in V cells
+   *        "obstacle_cells_false_free" (labelled-obstacle cells decided F), "rigid_cells_false_free" (the same for
+   *        the cells holding an obstacle point other than vegetation), "mover_cells_s_share" (cells holding a moving
+   *        obstacle point decided S), "moving_point_iou" (points in V cells
    *        against moving points: TP / (TP + FP + FN); −1 without a moving point or a V point), with
    *        addSegmentation() "ground_segmentation.{precision,recall,f1,ground_as_obstacle}", and every count
    *        behind them under "counts." (for pooling several sequences: sum the counts, then divide).
