@@ -56,6 +56,7 @@ GroundPlaneFitter& GroundPlaneFitter::operator=(const GroundPlaneFitter& other)
   if (this == &other) return *this;
   configure(other.params_);
   planes_ = other.planes_;
+  own_ = other.own_;
   return *this;
 }
 
@@ -77,6 +78,7 @@ void GroundPlaneFitter::configure(const GroundModelParams& params)
   ring_first_.assign(1, 0);
   for (const int n : ring_sectors_) ring_first_.push_back(ring_first_.back() + n);
   planes_.assign(static_cast<std::size_t>(numZones()), GroundPlane{ 0.0f, 0.0f, static_cast<float>(params.ground_height) });
+  own_.assign(static_cast<std::size_t>(numZones()), 0);
   pcl_->seg.setOptimizeCoefficients(true);
   pcl_->seg.setModelType(pcl::SACMODEL_PLANE);
   pcl_->seg.setMethodType(pcl::SAC_RANSAC);
@@ -92,6 +94,7 @@ GroundFitStats GroundPlaneFitter::fit(const float* dx, const float* dy, const fl
   st.zones = zones;
   const GroundPlane flat{ 0.0f, 0.0f, static_cast<float>(params_.ground_height) };
   planes_.assign(zones, flat);
+  own_.assign(zones, 0);
 
   zone_begin_.assign(zones + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++zone_begin_[zone[i] + 1u];
@@ -114,6 +117,7 @@ GroundFitStats GroundPlaneFitter::fit(const float* dx, const float* dy, const fl
       const bool own = params_.model == GroundModel::kZones ? fitLowest(k, predicted, inner_from, inner_radius, dx, dy, z, st)
                                                              : fitRansac(k, predicted, dx, dy, z, st);
       st.fitted += own;
+      own_[k] = own;
     }
   }
   if (st.fitted == 0)
@@ -294,7 +298,10 @@ bool GroundPlaneFitter::fitLowest(std::size_t k, const GroundPlane& predicted, f
     plane = GroundPlane{ static_cast<float>(-normal.x() / normal.z()), static_cast<float>(-normal.y() / normal.z()),
                          static_cast<float>(normal.dot(mean) / normal.z()) };
   }
-  if (!continuesGround(plane, predicted, mean, inner_from, inner_radius, params_.search_band, max_slope))
+  // Returns along a line tell no tilt, so nothing tells a lifted line (an object's lower edge with no ground seen
+  // under it) from the ground: such a line continues the ground only within kGroundLineBand of it.
+  const double band = line ? kGroundLineBand : params_.search_band;
+  if (!continuesGround(plane, predicted, mean, inner_from, inner_radius, band, line ? 0.0 : max_slope))
   {
     ++st.discontinuous;
     return false;

@@ -29,6 +29,10 @@ const std::vector<AddedStep>& addedSteps()
     { "ambiguous_unknown", "a ScanGrid cell holding a return neither ground nor obstacle gets no free mass",
       [](const Profile& p) { return p.scan_grid.ambiguous_unknown; },
       [](Profile& p) { p.scan_grid.ambiguous_unknown = false; } },
+    { "ground_consensus", "a return one fitted ground model calls ground and the other obstacle bounds free space, no mass "
+                          "(inert with the flat model)",
+      [](const Profile& p) { return p.scan_grid.ground_consensus; },
+      [](Profile& p) { p.scan_grid.ground_consensus = false; } },
     { "point_occupancy", "occupied evidence in the window cell under each obstacle return, not resampled scan cells",
       [](const Profile& p) { return p.map_grid.point_occupancy; },
       [](Profile& p) { p.map_grid.point_occupancy = false; } },

@@ -102,6 +102,17 @@ inline float readFloat(const std::uint8_t* p)
 }
 
 constexpr std::uint32_t kOutside = std::numeric_limits<std::uint32_t>::max();  // an obstacle return off the grid
+/// A return the two ground models of step ground consensus dispute: it bounds its sector's free space, marks no cell.
+constexpr std::uint32_t kDisputed = kOutside - 1;
+/// The bands of a height above the ground (PointPass::band()).
+enum HeightBand : int
+{
+  kBandBelow,
+  kBandGround,
+  kBandGap,
+  kBandObstacle,
+  kBandAbove,
+};
 
 /// What the point passes of ScanGridBuilder::build() read (the sensor model and the grid, as values) and where they
 /// write. Each chunk works on its own copy.
@@ -130,6 +141,9 @@ struct PointPass
   float* valid_z;
   std::uint16_t* valid_zone;
   const GroundPlaneFitter* fitter;
+  // Step "ground consensus": the second model's zone of each valid return and its fitter (nullptr when off).
+  std::uint16_t* valid_zone2;
+  const GroundPlaneFitter* second;
   // Step "ambiguous unknown": per cell, set when it holds a return neither ground nor obstacle (nullptr when off).
   std::uint8_t* ambiguous;
   // recordReturnClasses(): per point its class, per obstacle and valid return its point (nullptr when off).
@@ -150,6 +164,44 @@ struct PointPass
     if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
       __atomic_store_n(ambiguous + static_cast<int>(fy) * width + static_cast<int>(fx), std::uint8_t{ 1 },
                        __ATOMIC_RELAXED);
+  }
+
+  /// The band of a height @p h above the ground.
+  int band(float h) const
+  {
+    if (h < -tolerance) return kBandBelow;
+    if (h <= tolerance) return kBandGround;
+    if (h < obstacle_min) return kBandGap;
+    return h <= obstacle_max ? kBandObstacle : kBandAbove;
+  }
+
+  /// Step "ground consensus": classifies a return against the ground heights @p g of the first model and @p g2 of
+  /// the second. Ground for one and obstacle for the other: disputed (it bounds the free space of its sector, gives
+  /// no mass, and its cell is ambiguous). Otherwise an obstacle for either is an obstacle, and the first model
+  /// decides the rest.
+  template <class Out>
+  void classifyBoth(std::size_t point, float dx, float dy, float z, float r2, float g, float g2, Out& out) const
+  {
+    const int b1 = band(z - g), b2 = band(z - g2);
+    if ((b1 == kBandGround && b2 == kBandObstacle) || (b1 == kBandObstacle && b2 == kBandGround))
+    {
+      ++out.counts.disputed;
+      const std::size_t k = out.first + out.obstacle++;
+      obstacle_sector[k] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
+      obstacle_range2[k] = r2;
+      obstacle_cell[k] = kDisputed;
+      obstacle_xy[2 * k] = dx;
+      obstacle_xy[2 * k + 1] = dy;
+      if (relative) obstacle_z[k] = kInfinity;
+      if (point_class)
+      {
+        point_class[point] = ReturnClass::kDisputed;
+        obstacle_point[k] = static_cast<std::uint32_t>(point);
+      }
+      if (ambiguous) markAmbiguous(dx, dy);
+      return;
+    }
+    classify(point, dx, dy, z, r2, b2 == kBandObstacle ? g2 : g, out);
   }
 
   /// Classifies a valid return (point @p point of the view) at (dx, dy) from the sensor, height z, over ground
@@ -317,6 +369,9 @@ void ScanGridBuilder::configure(const ScanGridParams& params, const Eigen::Isome
   configured_ = true;
   ground_kind_ = params.groundModel();
   ground_.configure(params.groundModelParams());
+  GroundModelParams other = params.groundModelParams();
+  other.model = ground_kind_ == GroundModel::kZones ? GroundModel::kPlanes : GroundModel::kZones;
+  second_.configure(other);
   if (!parallel_ || parallel_->threads() != resolveThreads(params.threads))
     parallel_ = std::make_shared<const Parallel>(params.threads);
   if (!same_table) buildTable();
@@ -471,6 +526,14 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const valid_z = pass.valid_z = valid_z_.data();
   std::uint16_t* const valid_zone = pass.valid_zone = valid_zone_.data();
   pass.fitter = &ground_;
+  pass.second = nullptr;
+  pass.valid_zone2 = nullptr;
+  if (planes && params_.ground_consensus)
+  {
+    if (valid_zone2_.size() < n_points) valid_zone2_.resize(n_points);
+    pass.second = &second_;
+    pass.valid_zone2 = valid_zone2_.data();
+  }
   pass.ambiguous = nullptr;
   if (params_.ambiguous_unknown)
   {
@@ -560,6 +623,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
         m.valid_dy[v] = dy;
         m.valid_z[v] = z;
         m.valid_zone[v] = static_cast<std::uint16_t>(m.fitter->zoneOf(r2, turnFraction(dx, dy)));
+        if (m.second) m.valid_zone2[v] = static_cast<std::uint16_t>(m.second->zoneOf(r2, turnFraction(dx, dy)));
         if (m.valid_point) m.valid_point[v] = static_cast<std::uint32_t>(k);
         continue;
       }
@@ -578,6 +642,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     moveSegment(valid_dy, 1, out.first, out.valid, n_valid);
     moveSegment(valid_z, 1, out.first, out.valid, n_valid);
     moveSegment(valid_zone, 1, out.first, out.valid, n_valid);
+    if (pass.second) moveSegment(pass.valid_zone2, 1, out.first, out.valid, n_valid);
     if (pass.valid_point) moveSegment(pass.valid_point, 1, out.first, out.valid, n_valid);
     n_valid += out.valid;
   }
@@ -585,6 +650,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   if (planes)
   {
     st.ground_fit = ground_.fit(valid_dx, valid_dy, valid_z, valid_zone, n_valid);
+    if (pass.second) second_.fit(valid_dx, valid_dy, valid_z, pass.valid_zone2, n_valid);
     const std::size_t chunk_valid = pass.shared ? kPointChunk : std::max<std::size_t>(1, n_valid);
     n_chunks = chunkCount(n_valid, chunk_valid);
     valid_returns_.assign(n_chunks, ChunkReturns{});
@@ -597,8 +663,13 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
       for (std::size_t i = v0; i < v1; ++i)
       {
         const float dx = m.valid_dx[i], dy = m.valid_dy[i];
-        m.classify(m.valid_point ? m.valid_point[i] : 0, dx, dy, m.valid_z[i], dx * dx + dy * dy,
-                   m.fitter->plane(m.valid_zone[i]).at(dx, dy), out);
+        const std::size_t point = m.valid_point ? m.valid_point[i] : 0;
+        const float g = m.fitter->plane(m.valid_zone[i]).at(dx, dy);
+        if (m.second && m.second->fitted(m.valid_zone2[i]))  // a zone the second model did not fit has no say
+          m.classifyBoth(point, dx, dy, m.valid_z[i], dx * dx + dy * dy, g,
+                         m.second->plane(m.valid_zone2[i]).at(dx, dy), out);
+        else
+          m.classify(point, dx, dy, m.valid_z[i], dx * dx + dy * dy, g, out);
       }
       valid_out[c] = out;
     });
@@ -675,7 +746,8 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   st.height_gap = counts.gap;
   st.above_clearance = counts.above;
   st.ground = n_ground;
-  st.obstacle = n_obstacle;
+  st.disputed = counts.disputed;
+  st.obstacle = n_obstacle - counts.disputed;
 
   // Pass 2: per sector, the nearest obstacle; the free limit is it or the farthest ground return before it.
   float* const obstacle2 = sector_obstacle2_.data();
@@ -755,7 +827,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
     for (std::size_t k = 0; k < n_obstacle; ++k)
     {
       const std::uint32_t i = obstacle_cell_[k];
-      if (i == kOutside) continue;
+      if (i == kOutside || i == kDisputed) continue;
       if (m_o[i] != 0.0f) continue;
       if (m_f[i] > 0.0f) --free_cells;
       m_f[i] = 0.0f;
@@ -767,6 +839,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   const float sensor_x = static_cast<float>(table_sensor_x_), sensor_y = static_cast<float>(table_sensor_y_);
   for (std::size_t k = 0; k < n_obstacle; ++k)
   {
+    if (obstacle_cell_[k] == kDisputed) continue;  // bounds free space only
     if (obstacle_cell_[k] == kOutside)
     {
       ++st.obstacle_outside_grid;

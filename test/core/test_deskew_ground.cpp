@@ -471,3 +471,35 @@ TEST(GroundModel, ZonesRefuseAFlatRoofThatDoesNotContinueTheGround)
   EXPECT_GE(zones.ground_fit.discontinuous, 1u);
   EXPECT_EQ(zones.obstacle, platform);
 }
+
+TEST(GroundModel, ConsensusLeavesAReturnTheModelsDisputeWithoutMass)
+{
+  // A flat road and an embankment rising at 15° from 8 m to its left: `planes` calls the embankment an obstacle
+  // (steeper than its 5°), `zones` ground; with step ground consensus its returns are disputed: no occupied cell
+  // and no free one on it, and the free space of their sectors still ends at them.
+  const double rise = std::tan(15.0 * kPi / 180.0);
+  const auto g = [rise](double, double y) { return y > 8.0 ? rise * (y - 8.0) : 0.0; };
+  const std::vector<P> pts = groundSurface(g, 720, 0.25);
+  ScanGridParams params = groundParams("planes");
+  params.ground_consensus = false;
+  ScanGridBuilder alone(params, Eigen::Isometry3d::Identity());
+  params.ground_consensus = true;
+  ScanGridBuilder both(params, Eigen::Isometry3d::Identity());
+  ScanMassGrid ga, gb;
+  ScanGridStats sa, sb;
+  const auto view = PointCloudView::packed(pts.data(), pts.size(), sizeof(P));
+  ASSERT_TRUE(alone.build(view, ga, &sa));
+  ASSERT_TRUE(both.build(view, gb, &sb));
+  EXPECT_EQ(sa.disputed, 0u);
+  EXPECT_GT(sb.disputed, sa.obstacle / 2) << "most of what planes alone called obstacle is disputed";
+  EXPECT_EQ(sb.obstacle + sb.disputed + sb.ground + sb.height_gap + sb.below_ground + sb.above_clearance +
+                sb.low_relief + sb.rejected(),
+            sb.points);
+  EXPECT_LT(sb.occupied_cells, sa.occupied_cells / 2);
+  // Free space never reaches past a disputed return: every cell free with consensus is free without it.
+  const float* fa = ga.plane(FrameSG::kF);
+  const float* fb = gb.plane(FrameSG::kF);
+  std::size_t extra = 0;
+  for (std::size_t i = 0; i < ga.numCells(); ++i) extra += fb[i] > 0.0f && fa[i] == 0.0f;
+  EXPECT_EQ(extra, 0u);
+}

@@ -41,6 +41,7 @@ ScanGridParams testParams()
   p.mu_occupied = 0.8;
   p.relative_height_limit = 0.0;  // the paper's sensor model; the steps have their own tests
   p.ambiguous_unknown = false;
+  p.ground_consensus = false;
   p.ground_model = "flat";
   return p;
 }
@@ -777,14 +778,16 @@ TEST(ScanGrid, ReturnClassesNameWhatTheModelMadeOfEachPoint)
 TEST(ScanGrid, ReturnClassesAgreeWithTheCountsForAnyModelAndThreadCount)
 {
   const PaddedCloud cloud(64, 2100, 5);
-  for (const char* model : { "flat", "planes" })
+  for (const char* model : { "flat", "planes", "planes+consensus" })
     for (double relative : { 0.0, 0.8 })
     {
       std::vector<ReturnClass> first;
+      const bool consensus = std::string(model) == "planes+consensus";
       for (int threads : { 1, 2 })
       {
         ScanGridParams params = chunkedParams();
-        params.ground_model = model;
+        params.ground_model = consensus ? "planes" : model;
+        params.ground_consensus = consensus;
         params.relative_height_limit = relative;
         params.threads = threads;
         ScanGridBuilder builder(params, Eigen::Isometry3d::Identity());
@@ -804,9 +807,14 @@ TEST(ScanGrid, ReturnClassesAgreeWithTheCountsForAnyModelAndThreadCount)
         EXPECT_EQ(count(ReturnClass::kHeightGap), st.height_gap) << what;
         EXPECT_EQ(count(ReturnClass::kAboveClearance), st.above_clearance) << what;
         EXPECT_EQ(count(ReturnClass::kLowRelief), st.low_relief) << what;
-        if (relative > 0.0)
+        EXPECT_EQ(count(ReturnClass::kDisputed), st.disputed) << what;
+        if (relative > 0.0 && !consensus)
         {
           EXPECT_GT(st.low_relief, 0u) << what;
+        }
+        if (consensus)
+        {
+          EXPECT_GT(st.disputed, 0u) << what << ": the random cloud's two ground fits disagree somewhere";
         }
         if (threads == 1)
           first = c;

@@ -28,7 +28,8 @@
  *   foot lies inside the zone), or it rises from the predicted ground inside the zone within it (an embankment whose
  *   foot lies there, where that zone kept the road's plane); otherwise the zone keeps the predicted plane;
  * - returns along one line (spread across it below kGroundLineRatio of the spread along it: one far lidar ring, the
- *   foot of a wall) only tell the ground's height: the plane keeps the predicted tilt.
+ *   foot of a wall, a car's lower edge) only tell the ground's height: the plane keeps the predicted tilt, and it
+ *   continues the predicted ground only within kGroundLineBand of it.
  * The returns are then split against the plane of their own zone. PCL stays inside ground_model.cpp.
  */
 #pragma once
@@ -80,6 +81,9 @@ constexpr int kGroundFitIterations = 3;
 /// `zones`: a zone's returns whose spread across their main direction is below this share of their spread along it
 /// lie on a line (one far lidar ring, a wall's foot): their plane keeps the predicted tilt.
 constexpr double kGroundLineRatio = 0.1;
+/// `zones`: returns along a line continue the predicted ground only within this of it, m (a car's lower edge seen
+/// without the ground under it is 0.3–0.5 m up; a far ring of the ground within a few centimetres).
+constexpr double kGroundLineBand = 0.15;
 
 /// Parameters of the `planes` and `zones` ground models (ScanGridParams carries them; names as in config/scan_grid.yaml).
 struct GroundModelParams
@@ -149,6 +153,8 @@ public:
   GroundFitStats fit(const float* dx, const float* dy, const float* z, const std::uint16_t* zone, std::size_t n);
 
   const GroundPlane& plane(int zone) const { return planes_[static_cast<std::size_t>(zone)]; }
+  /// True when the last fit() gave @p zone a plane of its own (not the one predicted from inside it).
+  bool fitted(int zone) const { return own_[static_cast<std::size_t>(zone)] != 0; }
   const std::vector<GroundPlane>& planes() const { return planes_; }
 
 private:
@@ -171,6 +177,7 @@ private:
   std::vector<int> ring_sectors_;    // sectors of each ring
   std::vector<int> ring_first_{ 0 };  // first zone of each ring, then the number of zones
   std::vector<GroundPlane> planes_;
+  std::vector<std::uint8_t> own_;  // per zone: fitted by the last fit()
   std::vector<std::uint32_t> zone_begin_, order_, candidates_, inliers_;
   std::unique_ptr<Pcl> pcl_;
 };

@@ -19,6 +19,7 @@ enum class ReturnClass : std::uint8_t
   kHeightGap = 4,       ///< between the ground band and the obstacle band (neither)
   kAboveClearance = 5,  ///< above obstacle_max_height (neither)
   kLowRelief = 6,       ///< in the obstacle band, too close to the local lowest return (neither)
+  kDisputed = 7,        ///< ground for one ground model, obstacle for the other (step ground consensus): neither
 };
 
 }  // namespace core

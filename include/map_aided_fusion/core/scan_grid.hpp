@@ -99,10 +99,21 @@ struct ScanGridParams
   double relative_height_limit = 0.8;
   /**
    * Step "ambiguous unknown" (not in the paper): a cell holding a return that is neither ground nor obstacle (in the
-   * gap between the ground band and the obstacle band, or dropped by the relative obstacle height) gets no free mass:
+   * gap between the ground band and the obstacle band, dropped by the relative obstacle height, or disputed by step
+   * ground consensus) gets no free mass:
    * what the sensor model cannot call ground or obstacle is unknown, not free.
    */
   bool ambiguous_unknown = true;
+  /**
+   * Step "ground consensus" (not in the paper), with a fitted ground model: the other fitted model (`zones` for
+   * `planes`, `planes` for `zones`) is fitted to the same returns, and a return that one model puts on the ground and
+   * the other in the obstacle band is disputed: it bounds the free space of its sector (the ray ended there) but
+   * gives no occupied mass, and with step ambiguous unknown its cell no free mass. Otherwise a return in the obstacle
+   * band of either model is an obstacle, and the model of ground_model decides the rest. Two ground fits that
+   * disagree about a return are two sources in conflict: the cell is left to ignorance rather than to the fusion,
+   * which read the disagreement, sweep after sweep, as motion.
+   */
+  bool ground_consensus = true;
 
   /**
    * Step "deskew" (not in the paper): clouds whose points carry a time field are moved to the sensor's pose at
@@ -176,6 +187,7 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("free_margin", p.free_margin, { "m", "cells nearer than this to a sector's first obstacle stay unknown rather than free" });
   get("relative_height_limit", p.relative_height_limit, { "m", "step: a low obstacle return must stand obstacle_min_height above the lowest return around it; 0: off" });
   get("ambiguous_unknown", p.ambiguous_unknown, { "", "step: a cell holding a return neither ground nor obstacle gets no free mass" });
+  get("ground_consensus", p.ground_consensus, { "", "step: a return one fitted ground model calls ground and the other obstacle bounds free space but gives no mass" });
   get("deskew", p.deskew, { "", "step: clouds with a per-point time field are moved to the sensor pose at the stamp" });
   get("deskew_max_sweep_duration", p.deskew_max_sweep_duration, { "s", "a point time beyond this after the stamp skips deskewing" });
   get("ground_model", p.ground_model, { "", "flat (z = ground_height), planes (RANSAC planes per zone and scan) or zones (region-wise planes from the lowest returns, 504 zones)" });
@@ -234,6 +246,7 @@ struct ScanGridStats
   std::size_t height_gap = 0;           ///< between the ground band and the obstacle band (neither)
   std::size_t above_clearance = 0;      ///< above obstacle_max_height (neither)
   std::size_t low_relief = 0;           ///< in the obstacle band but too close to the local lowest return (neither)
+  std::size_t disputed = 0;             ///< ground for one ground model, obstacle for the other (step ground consensus)
   std::size_t occupied_cells = 0;       ///< cells with m(O) = μ_O
   std::size_t free_cells = 0;           ///< cells with m(F) > 0
   GroundFitStats ground_fit;            ///< the `planes` ground model's fit (all 0 with `flat`)
@@ -348,15 +361,18 @@ private:
   std::vector<float> valid_dx_, valid_dy_, valid_z_;
   std::vector<std::uint16_t> valid_zone_;
   GroundPlaneFitter ground_;
+  GroundPlaneFitter second_;  // step ground consensus: the other fitted model
+  std::vector<std::uint16_t> valid_zone2_;
 
   // Threads of build() (ScanGridParams::threads) and what each chunk of points found.
   std::shared_ptr<const Parallel> parallel_;
   struct ReturnCounts
   {
     std::size_t non_finite = 0, no_return = 0, below_min = 0, beyond_max = 0, self = 0;
-    std::size_t below_ground = 0, gap = 0, above = 0;
+    std::size_t below_ground = 0, gap = 0, above = 0, disputed = 0;
     ReturnCounts& operator+=(const ReturnCounts& o)
     {
+      disputed += o.disputed;
       non_finite += o.non_finite;
       no_return += o.no_return;
       below_min += o.below_min;
