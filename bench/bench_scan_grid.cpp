@@ -1,5 +1,6 @@
 // ScanGrid construction: a 64-beam-like cloud into a 160 m × 160 m grid at 0.2 m (BM_ScanGrid/points:N/threads:T;
-// with the `planes` ground model BM_ScanGridGround/points:N/threads:T; its deskewing at 15 m/s BM_Deskew/N), the
+// with the `planes` ground model and step ground consensus BM_ScanGridGround/points:N/threads:T, without the step
+// BM_ScanGridGroundAlone; its deskewing at 15 m/s BM_Deskew/N), the
 // paper's IBEO Alaska XT case (4 layers, ~800 points, 0.5 m cells; BM_ScanGridPaper/N), and the one-off
 // cost of the geometry table (BM_ScanGridTable).
 #include <benchmark/benchmark.h>
@@ -93,13 +94,14 @@ ScanGridParams spinningParams()
 
 /// The 64-beam street cloud of @p state.range(0) points into the 160 m grid with @p ground_model, on
 /// state.range(1) threads (ScanGridParams::threads).
-void scanGrid(benchmark::State& state, const char* ground_model)
+void scanGrid(benchmark::State& state, const char* ground_model, bool consensus = true)
 {
   const std::size_t n = static_cast<std::size_t>(state.range(0));
   const double h = 1.8;
   const auto cloud = makeCloud(n, 64, -25.0, 15.0, -kPi, 2.0 * kPi, h);
   ScanGridParams p = spinningParams();
   p.ground_model = ground_model;
+  p.ground_consensus = consensus;
   p.threads = static_cast<int>(state.range(1));
   ScanGridBuilder builder(p, sensorAt(0.9, h));
   ScanMassGrid grid(builder.geometry());
@@ -123,6 +125,11 @@ BENCHMARK(BM_ScanGrid)->ArgsProduct({ { 0, 130000, 260000 }, { 1, 2 } })->ArgNam
 
 void BM_ScanGridGround(benchmark::State& state) { scanGrid(state, "planes"); }
 BENCHMARK(BM_ScanGridGround)->ArgsProduct({ { 130000 }, { 1, 2 } })->ArgNames({ "points", "threads" })
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
+
+/// The `planes` model alone: without step ground consensus (which fits `zones` beside it).
+void BM_ScanGridGroundAlone(benchmark::State& state) { scanGrid(state, "planes", false); }
+BENCHMARK(BM_ScanGridGroundAlone)->ArgsProduct({ { 130000 }, { 1 } })->ArgNames({ "points", "threads" })
     ->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_Deskew(benchmark::State& state)

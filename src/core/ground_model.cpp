@@ -12,6 +12,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "map_aided_fusion/core/parallel.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
 
 namespace map_aided_fusion {
@@ -87,7 +88,7 @@ void GroundPlaneFitter::configure(const GroundModelParams& params)
 }
 
 GroundFitStats GroundPlaneFitter::fit(const float* dx, const float* dy, const float* z, const std::uint16_t* zone,
-                                      std::size_t n)
+                                      std::size_t n, const Parallel* parallel)
 {
   GroundFitStats st;
   const std::size_t zones = static_cast<std::size_t>(numZones());
@@ -105,27 +106,54 @@ GroundFitStats GroundPlaneFitter::fit(const float* dx, const float* dy, const fl
     for (std::size_t i = 0; i < n; ++i) order_[next[zone[i]]++] = static_cast<std::uint32_t>(i);
   }
 
-  for (int ring = 0; ring < numRings(); ++ring)
-  {
-    const float inner_radius = ring == 0 ? 0.0f : std::sqrt(ring_edges2_[static_cast<std::size_t>(ring - 1)]);
-    const float inner_from = ring < 2 ? 0.0f : std::sqrt(ring_edges2_[static_cast<std::size_t>(ring - 2)]);
-    for (int sector = 0; sector < ring_sectors_[static_cast<std::size_t>(ring)]; ++sector)
-    {
-      const std::size_t k = static_cast<std::size_t>(ring_first_[static_cast<std::size_t>(ring)] + sector);
-      const GroundPlane predicted = ring == 0 ? flat : planes_[innerZone(ring, sector)];
-      planes_[k] = predicted;
-      const bool own = params_.model == GroundModel::kZones ? fitLowest(k, predicted, inner_from, inner_radius, dx, dy, z, st)
-                                                             : fitRansac(k, predicted, dx, dy, z, st);
-      st.fitted += own;
-      own_[k] = own;
-    }
-  }
+  for (int ring = 0; ring < numRings(); ++ring) fitRing(ring, flat, dx, dy, z, parallel, st);
   if (st.fitted == 0)
   {
     planes_.assign(zones, flat);
     st.flat_fallback = true;
   }
   return st;
+}
+
+void GroundPlaneFitter::fitRing(int ring, const GroundPlane& flat, const float* dx, const float* dy, const float* z,
+                                const Parallel* parallel, GroundFitStats& st)
+{
+  const float inner_radius = ring == 0 ? 0.0f : std::sqrt(ring_edges2_[static_cast<std::size_t>(ring - 1)]);
+  const float inner_from = ring < 2 ? 0.0f : std::sqrt(ring_edges2_[static_cast<std::size_t>(ring - 2)]);
+  const std::size_t sectors = static_cast<std::size_t>(ring_sectors_[static_cast<std::size_t>(ring)]);
+  const std::size_t first = static_cast<std::size_t>(ring_first_[static_cast<std::size_t>(ring)]);
+  if (params_.model != GroundModel::kZones)
+  {
+    for (std::size_t s = 0; s < sectors; ++s)  // PCL's RANSAC keeps state: one zone after the other
+    {
+      const std::size_t k = first + s;
+      planes_[k] = ring == 0 ? flat : planes_[innerZone(ring, static_cast<int>(s))];
+      own_[k] = fitRansac(k, planes_[k], dx, dy, z, st);
+      st.fitted += own_[k];
+    }
+    return;
+  }
+  // A zone reads the planes of the ring inside it and writes its own: a ring's zones fit at once, each with its own
+  // scratch and counts, added in zone order (the same planes and counts for any thread count).
+  if (scratch_.size() < sectors) scratch_.resize(sectors);
+  ring_stats_.assign(sectors, GroundFitStats{});
+  const auto one = [&](std::size_t s) {
+    const std::size_t k = first + s;
+    const GroundPlane predicted = ring == 0 ? flat : planes_[innerZone(ring, static_cast<int>(s))];
+    planes_[k] = predicted;
+    own_[k] = fitLowest(k, predicted, inner_from, inner_radius, dx, dy, z, scratch_[s], ring_stats_[s]);
+  };
+  if (parallel && parallel->threads() > 1)
+    parallel->forChunks(sectors, one);
+  else
+    for (std::size_t s = 0; s < sectors; ++s) one(s);
+  for (std::size_t s = 0; s < sectors; ++s)
+  {
+    st.fitted += own_[first + s];
+    st.few_points += ring_stats_[s].few_points;
+    st.too_steep += ring_stats_[s].too_steep;
+    st.discontinuous += ring_stats_[s].discontinuous;
+  }
 }
 
 std::size_t GroundPlaneFitter::innerZone(int ring, int s) const
@@ -233,48 +261,52 @@ bool continuesGround(const GroundPlane& plane, const GroundPlane& predicted, con
 }  // namespace
 
 bool GroundPlaneFitter::lowestPlane(std::size_t k, const GroundPlane& predicted, const float* dx, const float* dy,
-                                    const float* z, Eigen::Vector3d& normal, Eigen::Vector3d& mean, bool& line)
+                                    const float* z, Eigen::Vector3d& normal, Eigen::Vector3d& mean, bool& line,
+                                    ZoneScratch& scratch) const
 {
+  std::vector<std::uint32_t>& candidates = scratch.candidates;
+  std::vector<std::uint32_t>& inliers = scratch.inliers;
   const float band = static_cast<float>(params_.search_band);
   const std::size_t min_points = static_cast<std::size_t>(params_.min_points);
   // The zone's returns, reflections far below the predicted ground left out, lowest first.
-  candidates_.clear();
+  candidates.clear();
   for (std::uint32_t j = zone_begin_[k]; j < zone_begin_[k + 1]; ++j)
   {
     const std::uint32_t i = order_[j];
-    if (z[i] >= predicted.at(dx[i], dy[i]) - band) candidates_.push_back(i);
+    if (z[i] >= predicted.at(dx[i], dy[i]) - band) candidates.push_back(i);
   }
-  if (candidates_.size() < min_points) return false;
-  std::sort(candidates_.begin(), candidates_.end(),
+  if (candidates.size() < min_points) return false;
+  std::sort(candidates.begin(), candidates.end(),
             [z](std::uint32_t a, std::uint32_t b) { return z[a] < z[b] || (z[a] == z[b] && a < b); });
-  const std::size_t lowest = std::min(kGroundLowestPoints, candidates_.size());
+  const std::size_t lowest = std::min(kGroundLowestPoints, candidates.size());
   double lpr = 0.0;
-  for (std::size_t j = 0; j < lowest; ++j) lpr += z[candidates_[j]];
+  for (std::size_t j = 0; j < lowest; ++j) lpr += z[candidates[j]];
   lpr /= static_cast<double>(lowest);
-  inliers_.clear();
-  for (const std::uint32_t i : candidates_)
+  inliers.clear();
+  for (const std::uint32_t i : candidates)
   {
     if (z[i] >= lpr + kGroundSeedBand) break;
-    inliers_.push_back(i);
+    inliers.push_back(i);
   }
   for (int it = 0; it < kGroundFitIterations; ++it)
   {
-    if (!pcaPlane(inliers_, dx, dy, z, normal, mean)) break;
+    if (!pcaPlane(inliers, dx, dy, z, normal, mean)) break;
     const double d = -normal.dot(mean);
-    inliers_.clear();
-    for (const std::uint32_t i : candidates_)
+    inliers.clear();
+    for (const std::uint32_t i : candidates)
       if (std::abs(normal.x() * dx[i] + normal.y() * dy[i] + normal.z() * z[i] + d) <= params_.fit_tolerance)
-        inliers_.push_back(i);
+        inliers.push_back(i);
   }
-  return inliers_.size() >= min_points && pcaPlane(inliers_, dx, dy, z, normal, mean, &line);
+  return inliers.size() >= min_points && pcaPlane(inliers, dx, dy, z, normal, mean, &line);
 }
 
 bool GroundPlaneFitter::fitLowest(std::size_t k, const GroundPlane& predicted, float inner_from, float inner_radius,
-                                  const float* dx, const float* dy, const float* z, GroundFitStats& st)
+                                  const float* dx, const float* dy, const float* z, ZoneScratch& scratch,
+                                  GroundFitStats& st)
 {
   Eigen::Vector3d normal, mean;
   bool line = false;
-  if (!lowestPlane(k, predicted, dx, dy, z, normal, mean, line))
+  if (!lowestPlane(k, predicted, dx, dy, z, normal, mean, line, scratch))
   {
     ++st.few_points;
     return false;

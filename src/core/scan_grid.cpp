@@ -649,8 +649,8 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   std::size_t n_chunks = point_chunks;
   if (planes)
   {
-    st.ground_fit = ground_.fit(valid_dx, valid_dy, valid_z, valid_zone, n_valid);
-    if (pass.second) second_.fit(valid_dx, valid_dy, valid_z, pass.valid_zone2, n_valid);
+    st.ground_fit = ground_.fit(valid_dx, valid_dy, valid_z, valid_zone, n_valid, &par);
+    if (pass.second) second_.fit(valid_dx, valid_dy, valid_z, pass.valid_zone2, n_valid, &par);
     const std::size_t chunk_valid = pass.shared ? kPointChunk : std::max<std::size_t>(1, n_valid);
     n_chunks = chunkCount(n_valid, chunk_valid);
     valid_returns_.assign(n_chunks, ChunkReturns{});

@@ -46,6 +46,8 @@
 namespace map_aided_fusion {
 namespace core {
 
+class Parallel;
+
 /// How the ScanGrid finds the ground.
 enum class GroundModel
 {
@@ -150,7 +152,8 @@ public:
    * @brief Fits every zone from the returns (dx, dy relative to the sensor, z in base_link) and their zones.
    * @return the counts; plane(zone) is then valid for every zone.
    */
-  GroundFitStats fit(const float* dx, const float* dy, const float* z, const std::uint16_t* zone, std::size_t n);
+  GroundFitStats fit(const float* dx, const float* dy, const float* z, const std::uint16_t* zone, std::size_t n,
+                     const Parallel* parallel = nullptr);
 
   const GroundPlane& plane(int zone) const { return planes_[static_cast<std::size_t>(zone)]; }
   /// True when the last fit() gave @p zone a plane of its own (not the one predicted from inside it).
@@ -162,13 +165,22 @@ private:
   /// `planes`: RANSAC on the zone's candidates; true when the zone got its own plane (else counted in @p st).
   bool fitRansac(std::size_t zone, const GroundPlane& predicted, const float* dx, const float* dy, const float* z,
                  GroundFitStats& st);
-  /// `zones`: least squares from the zone's lowest returns; true when the zone got its own plane.
+  /// `zones`: a zone's scratch lists (one per zone of a ring, so that a ring's zones fit in parallel).
+  struct ZoneScratch
+  {
+    std::vector<std::uint32_t> candidates, inliers;
+  };
+  /// `zones`: least squares from the zone's lowest returns; true when the zone got its own plane. Writes only
+  /// planes_[zone], @p scratch and @p st: the zones of one ring may fit at once.
   bool fitLowest(std::size_t zone, const GroundPlane& predicted, float inner_from, float inner_radius, const float* dx,
-                 const float* dy, const float* z, GroundFitStats& st);
+                 const float* dy, const float* z, ZoneScratch& scratch, GroundFitStats& st);
+  /// The zones of ring @p ring, one after the other or (with @p parallel) at once; their counts added to @p st.
+  void fitRing(int ring, const GroundPlane& flat, const float* dx, const float* dy, const float* z,
+               const Parallel* parallel, GroundFitStats& st);
   /// `zones`: the least-squares plane (normal, centroid) of zone @p zone's lowest returns; @p line when they lie on a
   /// line. False when too few returns support it.
   bool lowestPlane(std::size_t zone, const GroundPlane& predicted, const float* dx, const float* dy, const float* z,
-                   Eigen::Vector3d& normal, Eigen::Vector3d& mean, bool& line);
+                   Eigen::Vector3d& normal, Eigen::Vector3d& mean, bool& line, ZoneScratch& scratch) const;
   /// The zone of the ring inside @p ring that holds the middle of sector @p s of @p ring.
   std::size_t innerZone(int ring, int s) const;
 
@@ -178,7 +190,9 @@ private:
   std::vector<int> ring_first_{ 0 };  // first zone of each ring, then the number of zones
   std::vector<GroundPlane> planes_;
   std::vector<std::uint8_t> own_;  // per zone: fitted by the last fit()
-  std::vector<std::uint32_t> zone_begin_, order_, candidates_, inliers_;
+  std::vector<std::uint32_t> zone_begin_, order_, candidates_;
+  std::vector<ZoneScratch> scratch_;
+  std::vector<GroundFitStats> ring_stats_;
   std::unique_ptr<Pcl> pcl_;
 };
 
