@@ -127,8 +127,9 @@ void GroundPlaneFitter::fitRing(int ring, const GroundPlane& flat, const float* 
     for (std::size_t s = 0; s < sectors; ++s)  // PCL's RANSAC keeps state: one zone after the other
     {
       const std::size_t k = first + s;
-      planes_[k] = ring == 0 ? flat : planes_[innerZone(ring, static_cast<int>(s))];
-      own_[k] = fitRansac(k, planes_[k], dx, dy, z, st);
+      const GroundPlane predicted = ring == 0 ? flat : planes_[innerZone(ring, static_cast<int>(s))];
+      planes_[k] = predicted;
+      own_[k] = fitRansac(k, predicted, dx, dy, z, st);
       st.fitted += own_[k];
     }
     return;

@@ -383,6 +383,48 @@ void ScanGridBuilder::setSensorPose(const Eigen::Isometry3d& sensor_pose)
   configure(params_, sensor_pose);
 }
 
+void ScanGridBuilder::prepareStepBuffers(std::size_t n_points, bool fitted)
+{
+  if (fitted && params_.ground_consensus && valid_zone2_.size() < n_points) valid_zone2_.resize(n_points);
+  if (params_.ambiguous_unknown)
+  {
+    ambiguous_.resize(geometry_.numCells());
+    std::uint8_t* const amb = ambiguous_.data();
+    parallel_->forRange(ambiguous_.size(), kFillChunk,
+                        [amb](std::size_t i0, std::size_t i1) { std::fill(amb + i0, amb + i1, std::uint8_t{ 0 }); });
+  }
+  if (!record_classes_)
+  {
+    return_classes_.clear();
+    return;
+  }
+  // Every point starts rejected; classify() overwrites the valid returns.
+  return_classes_.assign(n_points, ReturnClass::kRejected);
+  obstacle_point_.resize(n_points + 1);
+  if (fitted) valid_point_.resize(n_points + 1);
+}
+
+std::size_t ScanGridBuilder::clearAmbiguousFree(float* m_f, float* m_omega) const
+{
+  // A cell holding a return that is neither ground nor obstacle is not free. Each chunk counts its own cells.
+  const std::uint8_t* const amb = ambiguous_.data();
+  std::vector<std::size_t> chunk_cleared(chunkCount(ambiguous_.size(), kFillChunk), 0);
+  parallel_->forRange(ambiguous_.size(), kFillChunk, [&](std::size_t i0, std::size_t i1) {
+    std::size_t cleared = 0;
+    for (std::size_t i = i0; i < i1; ++i)
+      if (amb[i] && m_f[i] > 0.0f)
+      {
+        m_f[i] = 0.0f;
+        m_omega[i] = 1.0f;
+        ++cleared;
+      }
+    chunk_cleared[i0 / kFillChunk] = cleared;
+  });
+  std::size_t cleared = 0;
+  for (const std::size_t c : chunk_cleared) cleared += c;
+  return cleared;
+}
+
 int ScanGridBuilder::sectorOf(double dx, double dy) const
 {
   return sectorIndex(static_cast<float>(dx), static_cast<float>(dy), sector_scale_, num_sectors_);
@@ -526,38 +568,14 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   float* const valid_z = pass.valid_z = valid_z_.data();
   std::uint16_t* const valid_zone = pass.valid_zone = valid_zone_.data();
   pass.fitter = &ground_;
-  pass.second = nullptr;
-  pass.valid_zone2 = nullptr;
-  if (planes && params_.ground_consensus)
-  {
-    if (valid_zone2_.size() < n_points) valid_zone2_.resize(n_points);
-    pass.second = &second_;
-    pass.valid_zone2 = valid_zone2_.data();
-  }
-  pass.ambiguous = nullptr;
-  if (params_.ambiguous_unknown)
-  {
-    ambiguous_.assign(geometry_.numCells(), 0);
-    pass.ambiguous = ambiguous_.data();
-  }
-  pass.point_class = nullptr;
-  pass.obstacle_point = nullptr;
-  pass.valid_point = nullptr;
-  if (record_classes_)
-  {
-    // Every point starts rejected; classify() overwrites the valid returns.
-    return_classes_.assign(n_points, ReturnClass::kRejected);
-    obstacle_point_.resize(n_points + 1);
-    pass.point_class = return_classes_.data();
-    pass.obstacle_point = obstacle_point_.data();
-    if (planes)
-    {
-      valid_point_.resize(n_points + 1);
-      pass.valid_point = valid_point_.data();
-    }
-  }
-  else
-    return_classes_.clear();
+  prepareStepBuffers(n_points, planes);
+  const bool consensus = planes && params_.ground_consensus;
+  pass.second = consensus ? &second_ : nullptr;
+  pass.valid_zone2 = consensus ? valid_zone2_.data() : nullptr;
+  pass.ambiguous = params_.ambiguous_unknown ? ambiguous_.data() : nullptr;
+  pass.point_class = record_classes_ ? return_classes_.data() : nullptr;
+  pass.obstacle_point = record_classes_ ? obstacle_point_.data() : nullptr;
+  pass.valid_point = record_classes_ && planes ? valid_point_.data() : nullptr;
   // The lists do not depend on the chunks (each chunk's returns are in point order, and chunks are joined in order),
   // so one thread takes all the points in one chunk, with nothing to move.
   const std::size_t chunk_points = pass.shared ? kPointChunk : std::max<std::size_t>(1, n_points);
@@ -808,18 +826,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   });
   std::size_t free_cells = 0;
   for (const std::size_t c : sector_chunk_free_) free_cells += c;
-  if (pass.ambiguous)
-  {
-    // Step "ambiguous unknown": a cell holding a return that is neither ground nor obstacle is not free.
-    const std::uint8_t* const amb = pass.ambiguous;
-    for (std::size_t i = 0; i < n; ++i)
-      if (amb[i] && m_f[i] > 0.0f)
-      {
-        m_f[i] = 0.0f;
-        m_omega[i] = 1.0f;
-        --free_cells;
-      }
-  }
+  if (pass.ambiguous) free_cells -= clearAmbiguousFree(m_f, m_omega);
 
   const float mu_o = static_cast<float>(params_.mu_occupied);
   std::size_t occupied = 0;

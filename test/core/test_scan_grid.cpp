@@ -829,16 +829,21 @@ TEST(ScanGrid, AmbiguousReturnsLeaveTheirCellUnknownNotFree)
   ScanGridParams p = testParams();
   p.azimuth_resolution_deg = 10.0;  // sector [0°, 10°) holds the centres of row 40 from column 43 on
   const int row = 40;
-  // Ground out to 12.25 m; a return in the gap between the bands at 5.25 m (cell 50), one at 8.25 m (cell 56).
-  const std::vector<P> pts{ { 12.25f, 0.1f, 0.0f }, { 5.25f, 0.05f, 0.25f }, { 8.25f, 0.05f, 0.27f } };
   ScanMassGrid off, on;
   ScanGridStats st_off, st_on;
-  ScanGridBuilder builder(p, Eigen::Isometry3d::Identity());
-  ASSERT_TRUE(builder.build(view(pts), off, &st_off));
+  ScanGridBuilder builder;
+  // The grids of @p pts without the step (off) and with it (on).
+  const auto buildBoth = [&](const std::vector<P>& pts) {
+    for (const bool step : { false, true })
+    {
+      p.ambiguous_unknown = step;
+      builder.configure(p, Eigen::Isometry3d::Identity());
+      ASSERT_TRUE(builder.build(view(pts), step ? on : off, step ? &st_on : &st_off));
+    }
+  };
+  // Ground out to 12.25 m; a return in the gap between the bands at 5.25 m (cell 50), one at 8.25 m (cell 56).
+  buildBoth({ { 12.25f, 0.1f, 0.0f }, { 5.25f, 0.05f, 0.25f }, { 8.25f, 0.05f, 0.27f } });
   for (int x = 43; x <= 63; ++x) expectFree(off, x, row);
-  p.ambiguous_unknown = true;
-  builder.configure(p, Eigen::Isometry3d::Identity());
-  ASSERT_TRUE(builder.build(view(pts), on, &st_on));
   for (int x = 43; x <= 63; ++x)
     if (x == 50 || x == 56)
       expectUnknown(on, x, row);
@@ -854,22 +859,12 @@ TEST(ScanGrid, AmbiguousReturnsLeaveTheirCellUnknownNotFree)
   pavement.push_back({ 14.25f, 0.1f, 0.0f });  // ground beyond it
   pavement.push_back({ 6.25f, 0.05f, 1.0f });  // an obstacle before it: the sector's free space ends there
   p.relative_height_limit = 0.8;
-  p.ambiguous_unknown = false;
-  builder.configure(p, Eigen::Isometry3d::Identity());
-  ASSERT_TRUE(builder.build(view(pavement), off, &st_off));
-  p.ambiguous_unknown = true;
-  builder.configure(p, Eigen::Isometry3d::Identity());
-  ASSERT_TRUE(builder.build(view(pavement), on, &st_on));
+  buildBoth(pavement);
   EXPECT_GT(st_on.low_relief, 0u);
   EXPECT_TRUE(samePlanes(on, off)) << "the pavement lies behind the obstacle: nothing free to take back";
   expectOccupied(on, 52, row);
   pavement.pop_back();  // without the obstacle the ground at 14.25 m frees the sector through the pavement
-  p.ambiguous_unknown = false;
-  builder.configure(p, Eigen::Isometry3d::Identity());
-  ASSERT_TRUE(builder.build(view(pavement), off, &st_off));
-  p.ambiguous_unknown = true;
-  builder.configure(p, Eigen::Isometry3d::Identity());
-  ASSERT_TRUE(builder.build(view(pavement), on, &st_on));
+  buildBoth(pavement);
   for (int x = 56; x <= 59; ++x)
   {
     expectFree(off, x, row);

@@ -314,6 +314,11 @@ public:
 
 private:
   void buildTable();
+  /// Sizes the per-build buffers of the steps and of recordReturnClasses() for a view of @p n_points
+  /// (@p fitted: a fitted ground model), or empties what is off.
+  void prepareStepBuffers(std::size_t n_points, bool fitted);
+  /// Step "ambiguous unknown": takes the free mass back from the cells ambiguous_ flags; returns how many were free.
+  std::size_t clearAmbiguousFree(float* m_f, float* m_omega) const;
 
   ScanGridParams params_;
   GridGeometry geometry_;
