@@ -72,6 +72,20 @@ void BM_ClusterReturns(benchmark::State& state)
   state.counters["returns"] = static_cast<double>(points.size());
 }
 
+/// A 100 m ScanGrid at 0.5 m, free but where the returns @p xy (x, y pairs) are.
+void freeButTheReturns(const std::vector<float>& xy, ScanMassGrid& grid)
+{
+  grid = ScanMassGrid(GridGeometry::centred(100.0, 100.0, 0.5));
+  const GridGeometry& g = grid.geometry();
+  for (std::size_t c = 0; c < g.numCells(); ++c) grid.setCell(c, MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } });
+  for (std::size_t p = 0; p + 1 < xy.size(); p += 2)
+  {
+    CellIndex c;
+    if (g.worldToCell(Point2{ xy[p], xy[p + 1] }, c))
+      grid.setCell(g.index(c), MassSG{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } });
+  }
+}
+
 /// Scan @p k of BM_TrackerScan: @p n objects of 4 × 1.8 m, 100 returns each (vehicle frame = map frame), and a
 /// 100 m ScanGrid at 0.5 m, free but where the returns are.
 void scanScene(int n, int k, std::mt19937& rng, std::vector<float>& xy, ScanMassGrid& grid)
@@ -88,15 +102,7 @@ void scanScene(int n, int k, std::mt19937& rng, std::vector<float>& xy, ScanMass
       xy.push_back(static_cast<float>(cy + 1.8 * u(rng)));
     }
   }
-  grid = ScanMassGrid(GridGeometry::centred(100.0, 100.0, 0.5));
-  const GridGeometry& g = grid.geometry();
-  for (std::size_t c = 0; c < g.numCells(); ++c) grid.setCell(c, MassSG{ { FrameSG::kF, 0.7 }, { FrameSG::kOmega, 0.3 } });
-  for (std::size_t p = 0; p + 1 < xy.size(); p += 2)
-  {
-    CellIndex c;
-    if (g.worldToCell(Point2{ xy[p], xy[p + 1] }, c))
-      grid.setCell(g.index(c), MassSG{ { FrameSG::kO, 0.8 }, { FrameSG::kOmega, 0.2 } });
-  }
+  freeButTheReturns(xy, grid);
 }
 
 void BM_TrackerScan(benchmark::State& state)
@@ -119,6 +125,53 @@ void BM_TrackerScan(benchmark::State& state)
     tracker.update(kScanPeriod * k, Pose2{}, ObstaclePoints{ r.data(), r.size() / 2 }, nullptr, &grids[k % kScenes]);
     ++k;
   }
+  state.counters["tracks"] = static_cast<double>(tracker.tracks().size());
+}
+
+/// Scan @p k of BM_TrackerClutter: @p n separate clusters of 20 returns within 0.3 m, on a lattice of 1.4 m (rain,
+/// a flock of birds, hedges), each moved by up to 0.1 m per scan; the ScanGrid as scanScene()'s.
+void clutterScene(int n, std::mt19937& rng, std::vector<float>& xy, ScanMassGrid& grid)
+{
+  constexpr int kReturns = 20;
+  constexpr double kSpacing = 1.4, kSpread = 0.3, kJitter = 0.1;
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  xy.clear();
+  for (int i = 0; i < n; ++i)
+  {
+    const double cx = -49.0 + kSpacing * (i % side) + kJitter * u(rng);
+    const double cy = -49.0 + kSpacing * (i / side) + kJitter * u(rng);
+    for (int p = 0; p < kReturns; ++p)
+    {
+      xy.push_back(static_cast<float>(cx + kSpread * u(rng)));
+      xy.push_back(static_cast<float>(cy + kSpread * u(rng)));
+    }
+  }
+  freeButTheReturns(xy, grid);
+}
+
+/// Arg: n clusters of clutter (clutterScene()), the default parameters (bounds included). The time per return
+/// (items) must not grow with n: the bounds and the association's grid keep the scan's cost linear.
+void BM_TrackerClutter(benchmark::State& state)
+{
+  const int n = static_cast<int>(state.range(0));
+  std::mt19937 rng(4);
+  constexpr int kScenes = 10;
+  std::vector<std::vector<float>> xy(kScenes);
+  std::vector<ScanMassGrid> grids(kScenes);
+  for (int k = 0; k < kScenes; ++k) clutterScene(n, rng, xy[k], grids[k]);
+  Tracker tracker;
+  int k = 0;
+  for (; k < kScenes; ++k)  // the tracks of the clutter established, up to max_tracks
+    tracker.update(kScanPeriod * k, Pose2{}, ObstaclePoints{ xy[k].data(), xy[k].size() / 2 }, nullptr, &grids[k]);
+  for (auto _ : state)
+  {
+    const std::vector<float>& r = xy[k % kScenes];
+    tracker.update(kScanPeriod * k, Pose2{}, ObstaclePoints{ r.data(), r.size() / 2 }, nullptr, &grids[k % kScenes]);
+    ++k;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(xy[0].size() / 2));
+  state.counters["returns"] = static_cast<double>(xy[0].size() / 2);
   state.counters["tracks"] = static_cast<double>(tracker.tracks().size());
 }
 
@@ -166,5 +219,6 @@ BENCHMARK(BM_TrackerScan)
     ->Args({ 200, 1, 1, 0 })
     ->Args({ 200, 1, 1, 1 })
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TrackerClutter)->ArgName("clusters")->Arg(200)->Arg(5000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TrackerUpdate)->Arg(200)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ClusterReturns)->Arg(200)->Unit(benchmark::kMicrosecond);

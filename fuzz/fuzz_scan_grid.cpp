@@ -6,22 +6,13 @@
 
 #include <sensor_msgs/PointCloud2.h>
 
+#include "fuzz_input.hpp"
 #include "map_aided_fusion/core/scan_grid.hpp"
 #include "map_aided_fusion/ros/point_cloud_view.hpp"
 
 namespace {
 
-/// Reads T from the input (zero when exhausted).
-template <class T>
-T take(const std::uint8_t*& p, std::size_t& n)
-{
-  T v{};
-  const std::size_t k = n < sizeof(T) ? n : sizeof(T);
-  std::memcpy(&v, p, k);
-  p += k;
-  n -= k;
-  return v;
-}
+using maf_fuzz::take;
 
 }  // namespace
 

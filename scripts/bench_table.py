@@ -55,6 +55,8 @@ ROWS = [
     ("BM_TrackerScan/n:200/free_space_check:1/open_ends:0/duplicates:0", "the same with the free-space check on a 100 m ScanGrid", "BM_TrackerScan/n:200/free_space_check:0/open_ends:0/duplicates:0"),
     ("BM_TrackerScan/n:200/free_space_check:1/open_ends:1/duplicates:0", "the same with step open ends too", "BM_TrackerScan/n:200/free_space_check:1/open_ends:0/duplicates:0"),
     ("BM_TrackerScan/n:200/free_space_check:1/open_ends:1/duplicates:1", "the same with step duplicates too (the default)", "BM_TrackerScan/n:200/free_space_check:1/open_ends:1/duplicates:0"),
+    ("BM_TrackerClutter/clusters:200", "a whole scan of clutter (rain, birds, hedges): 200 separate clusters of 20 returns on a 1.4 m lattice, the default bounds, one thread", None, ("returns", "tracks")),
+    ("BM_TrackerClutter/clusters:5000", "the same with 5,000 clusters: the bounds keep 1,000 measurements and tracks, the cost linear in the returns", "BM_TrackerClutter/clusters:200", ("returns", "tracks")),
     ("BM_SeenFree/200", "the free space of one scan the free-space check reads (margins 0.5 m and 0 m), 200 × 200 at 0.5 m, one thread", None),
     ("BM_SeenFree/800", "the same, 800 × 800 at 0.2 m (`high_resolution.test`'s ScanGrid)", None),
     ("BM_PriorFillWindow/1/0", "the PriorGrid window the fusion samples, coverage test", None),

@@ -56,9 +56,17 @@ double InputGapCounter::period() const
 std::size_t InputGapCounter::observe(double stamp)
 {
   if (!std::isfinite(stamp)) return 0;
-  if (!last_ || stamp <= *last_)
+  if (!last_)
   {
     last_ = stamp;
+    return 0;
+  }
+  if (stamp <= *last_)
+  {
+    // A duplicate or a stamp out of order leaves the reference (the stream goes on from the newest); a stamp far
+    // back (a looping bag, a restarted source) starts the count again.
+    const double t = period();
+    if (!(t > 0.0) || *last_ - stamp > kOutageFactor * t) last_ = stamp;
     return 0;
   }
   const double gap = stamp - *last_;

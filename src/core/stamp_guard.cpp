@@ -75,5 +75,40 @@ PoseJump checkPoseJump(double x0, double y0, double t0, double x1, double y1, do
   return j;
 }
 
+const char* toString(StartedVerdict v)
+{
+  switch (v)
+  {
+    case StartedVerdict::kShift:
+      return "shift";
+    case StartedVerdict::kNoScanYet:
+      return "no scan yet";
+    case StartedVerdict::kOtherFrame:
+      return "other frame";
+    case StartedVerdict::kBadStamp:
+      return "bad stamp";
+    case StartedVerdict::kNotNewer:
+      return "not newer";
+    case StartedVerdict::kImplausible:
+      return "implausible pose";
+    case StartedVerdict::kNoTransform:
+      return "no transform";
+  }
+  return "?";
+}
+
+StartedVerdict checkStarted(const StartedReference& ref, const std::string& frame, double stamp, bool stamp_ok,
+                            double x, double y, const TimeGuardParams& params)
+{
+  if (!std::isfinite(stamp) || stamp <= 0.0 || !stamp_ok) return StartedVerdict::kBadStamp;
+  if (ref.frame.empty()) return StartedVerdict::kNoScanYet;
+  if (frame != ref.frame) return StartedVerdict::kOtherFrame;
+  if (stamp <= ref.fused_stamp || (ref.shifted_stamp && stamp <= *ref.shifted_stamp)) return StartedVerdict::kNotNewer;
+  if (!std::isfinite(x) || !std::isfinite(y)) return StartedVerdict::kNoTransform;
+  if (checkPoseJump(ref.fused_x, ref.fused_y, ref.fused_stamp, x, y, stamp, params.max_plausible_speed).jumped)
+    return StartedVerdict::kImplausible;
+  return StartedVerdict::kShift;
+}
+
 }  // namespace core
 }  // namespace map_aided_fusion

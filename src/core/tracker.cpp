@@ -19,6 +19,16 @@ constexpr double kMinCellSize = 0.01;  // m
 constexpr double kMaxCellSize = 10.0;  // m
 constexpr double kTinySpeed = 1e-6;    // m/s: below, the speed's direction is undefined
 constexpr double kMinStep = 1e-6;      // s between two scans
+constexpr int kMaxBound = 1000000;     // max_measurements, max_tracks: beyond any scan, and memory
+/// Tracks or measurements of one gated component above which the association is greedy, not the cubic exact
+/// method (no component of any dataset comes near: a cluster of clutter where every object gates with the next).
+constexpr std::size_t kMaxExactComponent = 100;
+constexpr double kSymmetryTolerance = 1e-9;  // relative: a covariance's two off-diagonal terms differ by rounding only
+constexpr double kMaxBox = 1e6;  // m: a measurement's box beyond this (either way) is no object's: not used
+constexpr double kMinGateCell = 0.5;
+constexpr std::int64_t kMaxGateCells = 1024;  // cells one measurement or track covers in the association's grid, at most   // m: the association's grid cells are never smaller (max_gate_distance)
+constexpr double kGateSlack = 0.01;    // m added to the association's search radii (rounding)
+constexpr double kMaxCellCoordinate = 1e15;  // cell indices beyond: out of range (a return skipped, a track clamped)
 constexpr double kMaxDenseCells = 4e6;  // cells of the dense clustering grid (16 MB of indices) before a hash map
 constexpr double kOpenEndsMaxAngle = 20.0 * M_PI / 180.0;  // rad: step open ends probes the cluster's own faces, so it
                                                             // decides along a box axis this near one of them only
@@ -42,9 +52,24 @@ constexpr double kCommonTurnSolveTolerance = 1e-9;  // relative residual of its 
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
 const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
 
-std::int64_t cellKey(std::int64_t x, std::int64_t y) { return (x << 32) ^ (y & 0xffffffffLL); }
+std::int64_t cellKey(std::int64_t x, std::int64_t y)
+{
+  return static_cast<std::int64_t>((static_cast<std::uint64_t>(x) << 32) ^ (static_cast<std::uint64_t>(y) & 0xffffffffULL));
+}
 
 bool finite(const Eigen::Vector4d& x, const Eigen::Matrix4d& p) { return x.allFinite() && p.allFinite(); }
+
+/// A measurement a track may take: finite, a symmetric positive definite covariance, a box no larger than kMaxBox.
+bool usable(const Measurement& m)
+{
+  const auto bounded = [](double v) { return std::abs(v) <= kMaxBox; };  // false for NaN
+  const Eigen::Matrix2d& c = m.covariance;
+  return std::isfinite(m.centroid.x) && std::isfinite(m.centroid.y) && c.allFinite() && c(0, 0) > 0.0 &&
+         c.determinant() > 0.0 && std::abs(c(0, 1) - c(1, 0)) <= kSymmetryTolerance * (c(0, 0) + c(1, 1)) &&
+         std::isfinite(m.yaw) && bounded(m.lo_u) && bounded(m.hi_u) &&
+         bounded(m.lo_v) && bounded(m.hi_v) && bounded(m.length) && bounded(m.width) &&
+         (!m.has_sensor || (std::isfinite(m.sensor.x) && std::isfinite(m.sensor.y)));
+}
 
 /// Step hidden ends (TrackerParams::hidden_ends): @p m's two ends along its major axis are hidden and neither is open,
 /// and @p t is not yet moving.
@@ -142,10 +167,39 @@ Eigen::Vector2d fittedAxis(const std::vector<Point2>& points, const std::vector<
 
 }  // namespace
 
+namespace {
+
+/**
+ * The indices of the @p keep measurements nearest their sensor among @p n (measurement @p at(i)), in increasing index
+ * order (ties: the lower index); without a sensor position, the first @p keep.
+ */
+template <class At>
+std::vector<std::size_t> nearestFirst(At&& at, std::size_t n, std::size_t keep)
+{
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  keep = std::min(keep, n);
+  const auto distance = [&](std::size_t i) {
+    const Measurement& m = *at(i);
+    return m.has_sensor ? std::hypot(m.centroid.x - m.sensor.x, m.centroid.y - m.sensor.y) : 0.0;
+  };
+  std::vector<double> d(n);
+  for (std::size_t i = 0; i < n; ++i) d[i] = distance(i);
+  std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(keep), order.end(),
+                   [&](std::size_t a, std::size_t b) { return d[a] != d[b] ? d[a] < d[b] : a < b; });
+  order.resize(keep);
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+}  // namespace
+
 void TrackerParams::validate() const
 {
   requireInRange("tracker_cluster_distance", cluster_distance, 2.0 * kMinCellSize, 2.0 * kMaxCellSize);
   requireInRange("tracker_min_cluster_points", min_cluster_points, 1, 1e6);
+  requireInRange("tracker_max_measurements", max_measurements, 1, kMaxBound);
+  requireInRange("tracker_max_tracks", max_tracks, 1, kMaxBound);
   requireUnit("tracker_background_zeta", background_zeta);
   requireUnit("tracker_background_share", background_share);
   requireUnit("tracker_background_building", background_building);
@@ -214,11 +268,15 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
                                         const std::vector<std::uint8_t>* background)
 {
   const double cell = 0.5 * p.cluster_distance;
+  // A return this far out (a pose of 10¹⁵ m) has no cell index: skipped, as a non-finite one.
+  const auto clusterable = [&](Point2 q) {
+    return std::abs(q.x) / cell < kMaxCellCoordinate && std::abs(q.y) / cell < kMaxCellCoordinate;
+  };
   // Cells holding returns, each with its points; union-find over 8-connected cells. The cells are indexed in a dense
   // local grid over the returns' bounding box, or a hash map when that box is too large (far outliers).
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (const Point2& q : points)
-    if (std::isfinite(q.x) && std::isfinite(q.y))
+    if (clusterable(q))
     {
       x0 = std::min(x0, q.x);
       y0 = std::min(y0, q.y);
@@ -251,7 +309,7 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
   for (int i = 0; i < static_cast<int>(points.size()); ++i)
   {
     const Point2 q = points[i];
-    if (!std::isfinite(q.x) || !std::isfinite(q.y)) continue;
+    if (!clusterable(q)) continue;
     const auto cx = static_cast<std::int64_t>(std::floor(q.x / cell));
     const auto cy = static_cast<std::int64_t>(std::floor(q.y / cell));
     int* s = dense ? slot(cx, cy) : &sparse_index.emplace(cellKey(cx, cy), -1).first->second;
@@ -582,8 +640,11 @@ Tracker::Tracker(const TrackerParams& params) : params_(params) { params_.valida
 
 void Tracker::reset()
 {
+  ++counts_.resets;
   counts_.tracks_deleted += tracks_.size();
   tracks_.clear();
+  seen_free_.clear();
+  last_stamp_ = -1.0;
   common_motion_ = Point2{ 0.0, 0.0 };
   has_common_motion_ = false;
   common_turn_rate_ = 0.0;
@@ -886,8 +947,6 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
       checkPoseJump(last_pose_.x, last_pose_.y, last_stamp_, pose.x, pose.y, stamp, params_.max_ego_speed).jumped)
   {
     reset();
-    ++counts_.resets;
-    seen_free_.clear();
   }
   last_pose_ = pose;
   free_now_ = scan && params_.free_space_check;
@@ -928,6 +987,10 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   {
     m.has_sensor = true;
     m.sensor = Point2{ pose.x, pose.y };
+  }
+  capMeasurements(found);
+  for (Measurement& m : found)
+  {
     if (open_ends) findOpenEnds(m, seen_free_.back(), *scan, pose, params_.open_end_distance);
   }
   own_measurements_ = std::move(found);
@@ -1001,23 +1064,19 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
   }
   if (last_stamp_ >= 0.0 && stamp <= last_stamp_)
   {
-    if (!tracks_.empty())
-    {
-      reset();
-      ++counts_.resets;
-    }
+    if (!tracks_.empty()) reset();
   }
   const double dt = last_stamp_ >= 0.0 && stamp > last_stamp_ ? stamp - last_stamp_ : 0.0;
   last_stamp_ = stamp;
   measurements_.clear();
   for (const Measurement& m : measurements)
   {
-    if (std::isfinite(m.centroid.x) && std::isfinite(m.centroid.y) && m.covariance.allFinite() &&
-        m.covariance.determinant() > 0.0)
+    if (usable(m))
       measurements_.push_back(m);
     else
       ++counts_.non_finite_inputs;
   }
+  capMeasurements(measurements_);
   counts_.measurements += measurements_.size();
   for (Track& t : tracks_)
   {
@@ -1025,55 +1084,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     t.measurement = -1;
     t.fragments.clear();
   }
-
-  // Gated global assignment on the Mahalanobis distance of the innovation.
-  CostMatrix cost(static_cast<int>(tracks_.size()), static_cast<int>(measurements_.size()));
-  // Only measurements whose centroid is within reach in x: the followed point is at most half a box from it.
-  std::vector<int> by_x(measurements_.size());
-  for (std::size_t m = 0; m < by_x.size(); ++m) by_x[m] = static_cast<int>(m);
-  std::sort(by_x.begin(), by_x.end(),
-            [&](int a, int b) { return measurements_[a].centroid.x < measurements_[b].centroid.x; });
-  const double reach = params_.max_gate_distance + 0.5 * std::hypot(params_.max_object_length, params_.max_object_width);
-  for (int r = 0; r < cost.rows; ++r)
-  {
-    const Track& t = tracks_[r];
-    auto first = std::lower_bound(by_x.begin(), by_x.end(), t.x(0) - reach,
-                                  [&](int a, double x) { return measurements_[a].centroid.x < x; });
-    for (auto it = first; it != by_x.end() && measurements_[*it].centroid.x <= t.x(0) + reach; ++it)
-    {
-      const int m = *it;
-      const Measurement& z = measurements_[m];
-      if (z.split && std::max(t.extent_length, t.extent_width) > params_.background_split_size) continue;
-      const Point2 ref = referencePoint(t, z);
-      const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
-      if (y.norm() > params_.max_gate_distance) continue;
-      const Eigen::Matrix2d sm = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z, params_);
-      const double d2 = y.dot(sm.ldlt().solve(y));
-      if (std::isfinite(d2) && d2 <= params_.gate) cost.at(r, m) = d2;
-    }
-  }
-  const std::vector<int> pairs = solveAssignment(cost);
-  std::vector<char> used(measurements_.size(), 0);
-  for (int r = 0; r < cost.rows; ++r)
-  {
-    Track& t = tracks_[r];
-    if (pairs[r] >= 0)
-    {
-      if (takeSecondAxes(t, measurements_[pairs[r]], params_)) ++counts_.second_axes;
-      if (hiddenEnds(t, measurements_[pairs[r]], params_)) ++counts_.hidden_ends;
-      const bool open = openAnchor(t, measurements_[pairs[r]], params_);
-      counts_.open_anchor += open;
-      counts_.far_growth += farGrowth(t, measurements_[pairs[r]], params_, open);
-      if (correct(t, measurements_[pairs[r]], stamp)) ++counts_.long_box;
-      used[pairs[r]] = 1;
-      t.measurement = pairs[r];
-    }
-    else
-    {
-      t.consecutive_hits = 0;
-      if (t.state == TrackState::kConfirmed) t.state = TrackState::kCoasting;
-    }
-  }
+  const std::vector<char> used = associate(stamp);
   findCommonMotion(stamp);
   // Lifecycle: a tentative track missed once, a coasting track too long unseen, a broken state.
   std::vector<Track> kept;
@@ -1098,7 +1109,57 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     kept.push_back(std::move(t));
   }
   if (params_.duplicates) dropDuplicates(kept, stamp);
-  const double v2 = params_.initial_speed_sigma * params_.initial_speed_sigma;
+  startTracks(kept, used, stamp);
+  tracks_ = std::move(kept);
+  counts_.peak_tracks = std::max<std::uint64_t>(counts_.peak_tracks, tracks_.size());
+  if (params_.hidden_centre) rememberSeenBoxes();
+}
+
+void Tracker::capMeasurements(std::vector<Measurement>& found)
+{
+  counts_.peak_measurements = std::max<std::uint64_t>(counts_.peak_measurements, found.size());
+  const auto cap = static_cast<std::size_t>(params_.max_measurements);
+  if (found.size() <= cap) return;
+  counts_.measurements_dropped += found.size() - cap;
+  const std::vector<std::size_t> keep = nearestFirst([&](std::size_t i) { return &found[i]; }, found.size(), cap);
+  std::vector<Measurement> kept;
+  kept.reserve(cap);
+  for (const std::size_t i : keep) kept.push_back(std::move(found[i]));
+  found = std::move(kept);
+}
+
+std::vector<char> Tracker::associate(double stamp)
+{
+  std::size_t greedy = 0;
+  const std::vector<int> pairs = solveAssignment(gate(), kMaxExactComponent, &greedy);
+  counts_.greedy_associations += greedy;
+  std::vector<char> used(measurements_.size(), 0);
+  for (int r = 0; r < static_cast<int>(tracks_.size()); ++r)
+  {
+    Track& t = tracks_[r];
+    if (pairs[r] >= 0)
+    {
+      const Measurement& z = measurements_[pairs[r]];
+      if (takeSecondAxes(t, z, params_)) ++counts_.second_axes;
+      if (hiddenEnds(t, z, params_)) ++counts_.hidden_ends;
+      const bool open = openAnchor(t, z, params_);
+      counts_.open_anchor += open;
+      counts_.far_growth += farGrowth(t, z, params_, open);
+      if (correct(t, z, stamp)) ++counts_.long_box;
+      used[pairs[r]] = 1;
+      t.measurement = pairs[r];
+    }
+    else
+    {
+      t.consecutive_hits = 0;
+      if (t.state == TrackState::kConfirmed) t.state = TrackState::kCoasting;
+    }
+  }
+  return used;
+}
+
+void Tracker::startTracks(std::vector<Track>& kept, const std::vector<char>& used, double stamp)
+{
   const std::size_t seen_tracks = kept.size();
   // Step fragments: the box of a moving track seen this scan (with step duplicates, its object box), grown by the
   // margin, holds the centroid of a cluster no track took; with step duplicates the cluster is that track's piece.
@@ -1107,6 +1168,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     for (std::size_t j = 0; j < seen_tracks; ++j)
       if (kept[j].motion == TrackMotion::kMoving && kept[j].last_hit >= stamp)
         moving_boxes.emplace_back(j, params_.duplicates ? objectBox(kept[j], params_, measurements_) : ownBox(kept[j]));
+  std::vector<std::size_t> starts;
   for (std::size_t m = 0; m < measurements_.size(); ++m)
   {
     if (used[m]) continue;
@@ -1114,35 +1176,154 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     const auto owner = std::find_if(moving_boxes.begin(), moving_boxes.end(), [&](const auto& jb) {
       return inBox(jb.second, z.centroid, params_.fragment_margin);
     });
-    if (owner != moving_boxes.end())
+    if (owner == moving_boxes.end())
     {
-      ++counts_.fragments;
-      if (params_.duplicates) kept[owner->first].fragments.push_back(static_cast<int>(m));
+      starts.push_back(m);
       continue;
     }
-    Track t;
-    t.id = next_id_++;
-    // The middle of the cluster's box, the point referencePoint() follows.
-    const double mu = 0.5 * (z.lo_u + z.hi_u), mv = 0.5 * (z.lo_v + z.hi_v);
-    const double cu = std::cos(z.yaw), su = std::sin(z.yaw);
-    t.x << z.centroid.x + mu * cu - mv * su, z.centroid.y + mu * su + mv * cu, 0.0, 0.0;
-    t.P.setZero();
-    t.P.topLeftCorner<2, 2>() = z.covariance;
-    t.P(2, 2) = t.P(3, 3) = v2;
-    t.yaw = t.extent_yaw = z.yaw;
-    t.length = t.extent_length = t.widest_length = z.length;
-    t.width = t.extent_width = t.widest_width = z.width;
-    t.hits = t.consecutive_hits = 1;
-    t.first_stamp = t.last_hit = stamp;
-    t.measurement = static_cast<int>(m);
-    if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
-    if (free_now_) seeFreeSpace(t, stamp);
-    decideMotion(t, stamp);
-    kept.push_back(std::move(t));
-    ++counts_.tracks_created;
+    ++counts_.fragments;
+    if (params_.duplicates) kept[owner->first].fragments.push_back(static_cast<int>(m));
   }
-  tracks_ = std::move(kept);
-  if (params_.hidden_centre) rememberSeenBoxes();
+  // Within max_tracks, the clusters nearest the sensor start their tracks (in the measurements' order).
+  const std::size_t room = kept.size() < static_cast<std::size_t>(params_.max_tracks)
+                               ? static_cast<std::size_t>(params_.max_tracks) - kept.size()
+                               : 0;
+  if (starts.size() > room)
+  {
+    counts_.tracks_refused += starts.size() - room;
+    std::vector<std::size_t> nearest =
+        nearestFirst([&](std::size_t i) { return &measurements_[starts[i]]; }, starts.size(), room);
+    for (std::size_t& i : nearest) i = starts[i];
+    starts = std::move(nearest);
+  }
+  for (const std::size_t m : starts) kept.push_back(newTrack(measurements_[m], static_cast<int>(m), stamp));
+}
+
+Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
+{
+  Track t;
+  t.id = next_id_++;
+  // The middle of the cluster's box, the point referencePoint() follows.
+  const double mu = 0.5 * (z.lo_u + z.hi_u), mv = 0.5 * (z.lo_v + z.hi_v);
+  const double cu = std::cos(z.yaw), su = std::sin(z.yaw);
+  t.x << z.centroid.x + mu * cu - mv * su, z.centroid.y + mu * su + mv * cu, 0.0, 0.0;
+  t.P.setZero();
+  t.P.topLeftCorner<2, 2>() = z.covariance;
+  t.P(2, 2) = t.P(3, 3) = params_.initial_speed_sigma * params_.initial_speed_sigma;
+  t.yaw = t.extent_yaw = z.yaw;
+  t.length = t.extent_length = t.widest_length = z.length;
+  t.width = t.extent_width = t.widest_width = z.width;
+  t.hits = t.consecutive_hits = 1;
+  t.first_stamp = t.last_hit = stamp;
+  t.measurement = measurement;
+  if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
+  if (free_now_) seeFreeSpace(t, stamp);
+  decideMotion(t, stamp);
+  ++counts_.tracks_created;
+  return t;
+}
+
+namespace {
+
+/// The cells of a grid of side @p cell that a square of half side @p r about @p c covers, as a range of indices per
+/// axis; empty (wide) when it spans more than kMaxGateCells cells or is not finite.
+struct CellSpan
+{
+  std::int64_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+  bool wide = false;
+};
+
+CellSpan cellSpan(Point2 c, double r, double cell)
+{
+  const auto index = [&](double v) {
+    return static_cast<std::int64_t>(std::floor(std::clamp(v / cell, -kMaxCellCoordinate, kMaxCellCoordinate)));
+  };
+  CellSpan s;
+  if (!std::isfinite(r) || !(r / cell < kMaxGateCells))
+  {
+    s.wide = true;
+    return s;
+  }
+  s.x0 = index(c.x - r);
+  s.x1 = index(c.x + r);
+  s.y0 = index(c.y - r);
+  s.y1 = index(c.y + r);
+  s.wide = (s.x1 - s.x0 + 1) * (s.y1 - s.y0 + 1) > kMaxGateCells;
+  return s;
+}
+
+/// A cell's key; distinct cells may share one (a hash): that only adds candidates, which the gate judges.
+std::uint64_t gateKey(std::int64_t cx, std::int64_t cy)
+{
+  return (static_cast<std::uint64_t>(cx) << 32) ^ (static_cast<std::uint64_t>(cy) & 0xffffffffULL);
+}
+
+}  // namespace
+
+SparseCosts Tracker::gate() const
+{
+  SparseCosts cost;
+  cost.rows = static_cast<int>(tracks_.size());
+  cost.cols = static_cast<int>(measurements_.size());
+  if (cost.rows == 0 || cost.cols == 0) return cost;
+  // The point a track follows (referencePoint()) lies within √2 c + ½ d of the cluster's centroid, c the farthest
+  // corner of the cluster's box from it and d the diagonal of the track's box: a measurement is indexed in the cells
+  // of a grid that its centroid's disc of radius max_gate_distance + √2 c touches, and a track looks in the cells its
+  // own disc of ½ d touches. The cost grows with the objects near each other, not with tracks × measurements. A
+  // measurement or track wider than kMaxGateCells cells (boxes no cluster has) is paired with every other side.
+  const double cell = std::max(params_.max_gate_distance, kMinGateCell);
+  std::vector<std::pair<std::uint64_t, int>> index;
+  std::vector<int> wide;  // measurements met by every track
+  for (int m = 0; m < cost.cols; ++m)
+  {
+    const Measurement& z = measurements_[m];
+    const double c = std::hypot(std::max(std::abs(z.lo_u), std::abs(z.hi_u)), std::max(std::abs(z.lo_v), std::abs(z.hi_v)));
+    const CellSpan span = cellSpan(z.centroid, params_.max_gate_distance + std::sqrt(2.0) * c + kGateSlack, cell);
+    if (span.wide) wide.push_back(m);
+    for (std::int64_t cx = span.x0; cx <= span.x1 && !span.wide; ++cx)
+      for (std::int64_t cy = span.y0; cy <= span.y1; ++cy) index.emplace_back(gateKey(cx, cy), m);
+  }
+  std::sort(index.begin(), index.end());
+  std::vector<int> seen_by(measurements_.size(), -1);
+  const auto consider = [&](int t, int m) {
+    if (seen_by[m] == t) return;
+    seen_by[m] = t;
+    if (const std::optional<double> d2 = gateCost(tracks_[t], measurements_[m])) cost.pairs.push_back(GatedPair{ t, m, *d2 });
+  };
+  for (int t = 0; t < cost.rows; ++t)
+  {
+    const Track& track = tracks_[t];
+    const CellSpan span =
+        cellSpan(track.position(), 0.5 * std::hypot(track.extent_length, track.extent_width) + kGateSlack, cell);
+    for (const int m : wide) consider(t, m);
+    if (span.wide)
+    {
+      for (int m = 0; m < cost.cols; ++m) consider(t, m);
+      continue;
+    }
+    for (std::int64_t cx = span.x0; cx <= span.x1; ++cx)
+      for (std::int64_t cy = span.y0; cy <= span.y1; ++cy)
+      {
+        const std::uint64_t k = gateKey(cx, cy);
+        auto it = std::lower_bound(index.begin(), index.end(), k,
+                                   [](const std::pair<std::uint64_t, int>& e, std::uint64_t v) { return e.first < v; });
+        for (; it != index.end() && it->first == k; ++it) consider(t, it->second);
+      }
+  }
+  return cost;
+}
+
+std::optional<double> Tracker::gateCost(const Track& t, const Measurement& z) const
+{
+  if (z.split && std::max(t.extent_length, t.extent_width) > params_.background_split_size) return std::nullopt;
+  const Point2 ref = referencePoint(t, z);
+  const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
+  if (y.norm() > params_.max_gate_distance) return std::nullopt;
+  const Eigen::Matrix2d sm = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z, params_);
+  const double d2 = y.dot(sm.ldlt().solve(y));
+  // Not finite or negative when the predicted covariance lost its definiteness: no association.
+  if (std::isfinite(d2) && d2 >= 0.0 && d2 <= params_.gate) return d2;
+  return std::nullopt;
 }
 
 void Tracker::rememberSeenBoxes()

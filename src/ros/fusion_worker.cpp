@@ -78,10 +78,12 @@ FusionWorker::FusionWorker(ros::NodeHandle nh, ros::NodeHandle pnh)
   , grid_(loadMapGridParams(pnh))
   , stamp_guard_(node_params_.time)
   , clock_jump_(node_params_.time.time_jump_threshold)
+  , started_refused_window_(node_params_.health.diagnostic_window)
   , fused_window_(node_params_.health.diagnostic_window)
   , lost_window_(node_params_.health.diagnostic_window)
   , covariance_rejected_window_(node_params_.health.diagnostic_window)
   , tracker_resets_window_(node_params_.health.diagnostic_window)
+  , tracker_bounded_window_(node_params_.health.diagnostic_window)
   , tf_listener_(tf_buffer_, nh)
   , reconfigure_(pnh)
 {
@@ -317,9 +319,15 @@ void FusionWorker::resetForTimeJump(const std::string& why)
 {
   ROS_WARN_STREAM("fusion: " << why << "; resetting the MapGrid and clearing the tf buffer");
   grid_.reset();
-  if (tracker_) tracker_->reset();
+  if (tracker_)
+  {
+    tracker_->reset();
+    tracker_resets_seen_ = tracker_->counts().resets;
+    tracker_resets_window_.add(core::steadySeconds());
+  }
   stamp_guard_.reset();
   last_pose_.reset();
+  shifted_stamp_.reset();
   tf_buffer_.clear();
   ++counters_.resets;
   ++counters_.tf_clears;
@@ -378,10 +386,11 @@ void FusionWorker::checkClock()
 
 void FusionWorker::LatencyWindows::setSpan(double span)
 {
-  for (core::SlidingSamples* w : { &cloud_to_callback, &cloud_to_decision, &conversion, &shift, &shift_ahead,
-                                   &project_scan, &prior_window, &fusion, &tracking, &outputs, &skipped,
-                                   &changing })
+  for (core::SlidingSamples* w : { &conversion, &shift, &shift_ahead, &project_scan, &prior_window, &fusion, &tracking,
+                                   &outputs, &skipped, &changing })
     w->setSpan(span);
+  cloud_to_callback.setSpan(span);
+  cloud_to_decision.setSpan(span);
 }
 
 FusionWorker::AheadOfClock FusionWorker::aheadOfClock(double stamp) const
@@ -399,41 +408,113 @@ FusionWorker::AheadOfClock FusionWorker::aheadOfClock(double stamp) const
 void FusionWorker::onScanStarted(const std_msgs::Header::ConstPtr& header)
 {
   const double stamp = header->stamp.toSec();
-  if (stamp <= 0.0 || !tf_buffer_.canTransform(node_params_.map_frame, header->frame_id, header->stamp)) return;
-  core::Point2 p;
-  try
+  double x = std::numeric_limits<double>::quiet_NaN(), y = x;
+  if (stamp > 0.0 && tf_buffer_.canTransform(node_params_.map_frame, header->frame_id, header->stamp))
   {
-    const geometry_msgs::Transform t =
-        tf_buffer_.lookupTransform(node_params_.map_frame, header->frame_id, header->stamp).transform;
-    p = core::Point2{ t.translation.x, t.translation.y };
+    try
+    {
+      const geometry_msgs::Transform t =
+          tf_buffer_.lookupTransform(node_params_.map_frame, header->frame_id, header->stamp).transform;
+      x = t.translation.x;
+      y = t.translation.y;
+    }
+    catch (const tf2::TransformException&)
+    {
+    }
   }
-  catch (const tf2::TransformException&)
-  {
-    return;
-  }
-  if (!std::isfinite(p.x) || !std::isfinite(p.y)) return;
   std::lock_guard<std::mutex> lock(mutex_);
+  // A scan with new parameters changes the window's geometry: its own update shifts it (not a refusal).
+  if (pending_params_) return;
+  core::StartedReference ref;
+  if (last_pose_ && stamp_guard_.last())
+  {
+    ref.frame = fused_frame_;
+    ref.fused_stamp = *stamp_guard_.last();
+    ref.fused_x = last_pose_->x;
+    ref.fused_y = last_pose_->y;
+    ref.shifted_stamp = shifted_stamp_;
+  }
   const AheadOfClock ahead = aheadOfClock(stamp);
-  if (pending_params_ || ahead.too_far || stamp_guard_.check(stamp, ahead.clock_started) != core::StampVerdict::kFuse)
+  const core::StartedVerdict verdict = core::checkStarted(ref, header->frame_id, stamp, !ahead.too_far, x, y,
+                                                          node_params_.time);
+  if (verdict == core::StartedVerdict::kNoScanYet) return;
+  if (verdict != core::StartedVerdict::kShift)
+  {
+    ++counters_.started_refused[static_cast<std::size_t>(verdict)];
+    started_refused_window_.add(core::steadySeconds());
+    ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan_grid/started in '" << header->frame_id << "' at "
+                                                                            << header->stamp << " refused ("
+                                                                            << core::toString(verdict)
+                                                                            << "): the window stays; fused scans are in '"
+                                                                            << ref.frame << "'");
     return;
+  }
   const auto t0 = std::chrono::steady_clock::now();
-  if (grid_.follow(p)) ++counters_.shifts_ahead;
+  shifted_stamp_ = stamp;
+  if (grid_.follow(core::Point2{ x, y })) ++counters_.shifts_ahead;
   const std::chrono::duration<double> took = std::chrono::steady_clock::now() - t0;
   latency_.shift_ahead.add(core::steadySeconds(), kMillisecondsPerSecond * took.count());
 }
 
 void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
 {
-  const auto wall0 = std::chrono::steady_clock::now();
-  const double cloud_age_ms = kMillisecondsPerSecond * (ros::Time::now() - msg->header.stamp).toSec();
+  ScanTimes times;
+  times.start = std::chrono::steady_clock::now();
+  times.cloud_age_ms = kMillisecondsPerSecond * (ros::Time::now() - msg->header.stamp).toSec();
   // Reused from scan to scan (one per callback thread): no 10 MB allocation, page faults and zeroing per scan.
   thread_local core::ScanMassGrid scan;
+  if (!convertScan(*msg, scan)) return;
+  const std::optional<core::Pose2> pose = scanPose(*msg);
+  if (!pose) return;
+
+  std::lock_guard<std::mutex> lock(mutex_);
+  last_scan_frame_ = msg->header.frame_id;
+  if (pending_params_)
+  {
+    grid_.setParams(*pending_params_);
+    pending_params_.reset();
+  }
+  const double stamp = msg->header.stamp.toSec();
+  if (!admitStamp(msg->header.stamp)) return;
+  warnPoseJump(*pose, stamp);
+  const core::PriorWindow* prior = softenedPrior();
+  if (!prior && !warned_no_prior_)
+  {
+    ROS_INFO("fusion: no prior_grid received yet: fusing with a vacuous prior");
+    warned_no_prior_ = true;
+  }
+  const core::ObstaclePoints obstacles{ msg->obstacle_points.data(), msg->obstacle_points.size() / 2 };
+  times.update = std::chrono::steady_clock::now();
+  const auto stats =
+      grid_.update(scan, *pose, stamp, prior, &times.stages, msg->obstacle_points.empty() ? nullptr : &obstacles);
+  stamp_guard_.accept(stamp);
+  last_pose_ = *pose;
+  fused_frame_ = msg->header.frame_id;
+  shifted_stamp_.reset();
+  ++counters_.fused;
+  last_fused_wall_ = core::steadySeconds();
+  fused_window_.add(last_fused_wall_);
+  last_times_ = times.stages;
+  last_mean_conflict_ = stats.meanConflict();
+
+  std_msgs::Header header;
+  header.stamp = msg->header.stamp;
+  header.frame_id = node_params_.map_frame;
+  times.tracking = std::chrono::steady_clock::now();
+  if (tracker_) track(header, stamp, *pose, obstacles, scan, prior);
+  times.outputs = std::chrono::steady_clock::now();
+  publish(header, prior);
+  recordLatency(times, msg->header.stamp);
+}
+
+bool FusionWorker::convertScan(const EvidentialGrid& msg, core::ScanMassGrid& scan)
+{
   try
   {
-    GridConversions::scanFromMessage(*msg, scan);
-    if (msg->obstacle_points.size() % 2 != 0)
+    GridConversions::scanFromMessage(msg, scan);
+    if (msg.obstacle_points.size() % 2 != 0)
       throw ConversionError("obstacle_points holds an odd number of coordinates");
-    for (const float v : msg->obstacle_points)
+    for (const float v : msg.obstacle_points)
       if (!std::isfinite(v)) throw ConversionError("obstacle_points holds a non-finite coordinate");
   }
   catch (const ConversionError& e)
@@ -442,19 +523,24 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     countLost(counters_.rejected);
     ROS_ERROR_STREAM_THROTTLE(kWarnThrottle, "fusion: scan_grid rejected (" << counters_.rejected
                                                                             << " so far): " << e.what());
-    return;
+    return false;
   }
+  return true;
+}
+
+std::optional<core::Pose2> FusionWorker::scanPose(const EvidentialGrid& msg)
+{
   geometry_msgs::TransformStamped tf;
   try
   {
-    tf = tf_buffer_.lookupTransform(node_params_.map_frame, msg->header.frame_id, msg->header.stamp);
+    tf = tf_buffer_.lookupTransform(node_params_.map_frame, msg.header.frame_id, msg.header.stamp);
   }
   catch (const tf2::TransformException& e)
   {
     std::lock_guard<std::mutex> lock(mutex_);
     countLost(counters_.dropped_no_transform);
     ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan dropped: " << e.what());
-    return;
+    return std::nullopt;
   }
   core::Pose2 pose;
   pose.x = tf.transform.translation.x;
@@ -465,19 +551,16 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
     std::lock_guard<std::mutex> lock(mutex_);
     countLost(counters_.rejected);
     ROS_ERROR_STREAM_THROTTLE(kWarnThrottle, "fusion: scan dropped: the transform " << node_params_.map_frame << " <- "
-                                                                                    << msg->header.frame_id
+                                                                                    << msg.header.frame_id
                                                                                     << " is not finite");
-    return;
+    return std::nullopt;
   }
+  return pose;
+}
 
-  std::lock_guard<std::mutex> lock(mutex_);
-  last_scan_frame_ = msg->header.frame_id;
-  if (pending_params_)
-  {
-    grid_.setParams(*pending_params_);
-    pending_params_.reset();
-  }
-  const double stamp = msg->header.stamp.toSec();
+bool FusionWorker::admitStamp(const ros::Time& header_stamp)
+{
+  const double stamp = header_stamp.toSec();
   // checkClock() watches ROS time and resets the guard when it goes back; before the first clock value, stamps decide.
   switch (stamp_guard_.check(stamp, !ros::Time::now().isZero()))
   {
@@ -485,21 +568,21 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
       break;
     case core::StampVerdict::kZeroStamp:
       countLost(counters_.zero_stamp);
-      return;
+      return false;
     case core::StampVerdict::kDuplicate:
       countLost(counters_.duplicate);
-      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << header_stamp
                                                                      << " again (already fused), dropped; "
                                                                      << counters_.duplicate << " so far");
-      return;
+      return false;
     case core::StampVerdict::kOutOfOrder:
       countLost(counters_.out_of_order);
-      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << " is "
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << header_stamp << " is "
                                                                      << *stamp_guard_.last() - stamp
                                                                      << " s older than the last fused scan, dropped "
                                                                         "(out of order); "
                                                                      << counters_.out_of_order << " so far");
-      return;
+      return false;
     case core::StampVerdict::kLate:
       if (stamp_guard_.lateRun(core::steadySeconds()))
       {
@@ -511,13 +594,13 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
         break;
       }
       countLost(counters_.late);
-      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << msg->header.stamp << " is "
+      ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: scan stamped " << header_stamp << " is "
                                                                      << *stamp_guard_.last() - stamp
                                                                      << " s older than the last fused scan while the "
                                                                         "clock did not go back: released late (after "
                                                                         "a tf gap), dropped; "
                                                                      << counters_.late << " so far");
-      return;
+      return false;
     case core::StampVerdict::kTimeJump: {
       std::ostringstream why;
       why << "scan time went back from " << std::fixed << *stamp_guard_.last() << " to " << stamp
@@ -526,6 +609,11 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
       break;
     }
   }
+  return true;
+}
+
+void FusionWorker::warnPoseJump(const core::Pose2& pose, double stamp)
+{
   if (last_pose_)
   {
     const double last_stamp = *stamp_guard_.last();  // set with last_pose_, reset with it
@@ -541,47 +629,25 @@ void FusionWorker::onScan(const EvidentialGrid::ConstPtr& msg)
                                                       "still covers it");
     }
   }
-  const core::PriorWindow* prior = softenedPrior();
-  if (!prior && !warned_no_prior_)
-  {
-    ROS_INFO("fusion: no prior_grid received yet: fusing with a vacuous prior");
-    warned_no_prior_ = true;
-  }
-  core::StageTimes times;
-  const core::ObstaclePoints obstacles{ msg->obstacle_points.data(), msg->obstacle_points.size() / 2 };
-  const auto update_start = std::chrono::steady_clock::now();
-  const auto stats =
-      grid_.update(scan, pose, stamp, prior, &times, msg->obstacle_points.empty() ? nullptr : &obstacles);
-  stamp_guard_.accept(stamp);
-  last_pose_ = pose;
-  ++counters_.fused;
-  last_fused_wall_ = core::steadySeconds();
-  fused_window_.add(last_fused_wall_);
-  last_times_ = times;
-  last_mean_conflict_ = stats.meanConflict();
+}
 
-  std_msgs::Header header;
-  header.stamp = msg->header.stamp;
-  header.frame_id = node_params_.map_frame;
-  const auto tracking_start = std::chrono::steady_clock::now();
-  if (tracker_) track(header, stamp, pose, obstacles, scan, prior);
-  const auto outputs_start = std::chrono::steady_clock::now();
-  publish(header, prior);
+void FusionWorker::recordLatency(const ScanTimes& times, const ros::Time& header_stamp)
+{
   const auto end = std::chrono::steady_clock::now();
-  last_total_seconds_ = std::chrono::duration<double>(end - wall0).count();
+  last_total_seconds_ = std::chrono::duration<double>(end - times.start).count();
   const auto ms = [](auto a, auto b) { return kMillisecondsPerSecond * std::chrono::duration<double>(b - a).count(); };
   const double now = last_fused_wall_;
-  latency_.cloud_to_callback.add(now, cloud_age_ms);
-  latency_.cloud_to_decision.add(now, kMillisecondsPerSecond * (ros::Time::now() - msg->header.stamp).toSec());
-  latency_.conversion.add(now, ms(wall0, update_start));
-  latency_.shift.add(now, kMillisecondsPerSecond * times.shift);
-  latency_.project_scan.add(now, kMillisecondsPerSecond * times.project_scan);
-  latency_.prior_window.add(now, kMillisecondsPerSecond * times.prior_window);
-  latency_.fusion.add(now, kMillisecondsPerSecond * times.fusion);
+  latency_.cloud_to_callback.add(now, times.cloud_age_ms);
+  latency_.cloud_to_decision.add(now, kMillisecondsPerSecond * (ros::Time::now() - header_stamp).toSec());
+  latency_.conversion.add(now, ms(times.start, times.update));
+  latency_.shift.add(now, kMillisecondsPerSecond * times.stages.shift);
+  latency_.project_scan.add(now, kMillisecondsPerSecond * times.stages.project_scan);
+  latency_.prior_window.add(now, kMillisecondsPerSecond * times.stages.prior_window);
+  latency_.fusion.add(now, kMillisecondsPerSecond * times.stages.fusion);
   latency_.skipped.add(now, grid_.skippedShare());
   if (!std::isnan(grid_.changingShare())) latency_.changing.add(now, grid_.changingShare());
-  latency_.tracking.add(now, ms(tracking_start, outputs_start));
-  latency_.outputs.add(now, ms(outputs_start, end));
+  latency_.tracking.add(now, ms(times.tracking, times.outputs));
+  latency_.outputs.add(now, ms(times.outputs, end));
 }
 
 void FusionWorker::publish(const std_msgs::Header& header, const core::PriorWindow* prior)
@@ -641,7 +707,20 @@ void FusionWorker::track(const std_msgs::Header& header, double stamp, const cor
                           const core::ObstaclePoints& returns, const core::ScanMassGrid& scan,
                           const core::PriorWindow* prior)
 {
+  const core::TrackerCounts before = tracker_->counts();
   core::trackScan(*tracker_, grid_, stamp, pose, returns, background_, &scan, prior);
+  const core::TrackerCounts& after = tracker_->counts();
+  if (after.measurements_dropped > before.measurements_dropped || after.tracks_refused > before.tracks_refused)
+  {
+    tracker_bounded_window_.add(core::steadySeconds());
+    ROS_WARN_STREAM_THROTTLE(kWarnThrottle, "fusion: clutter: the tracker dropped "
+                                                << after.measurements_dropped - before.measurements_dropped
+                                                << " measurements over tracker_max_measurements ("
+                                                << tracker_->params().max_measurements << ") and left "
+                                                << after.tracks_refused - before.tracks_refused
+                                                << " clusters untracked over tracker_max_tracks ("
+                                                << tracker_->params().max_tracks << ") in this scan");
+  }
   if (tracker_->counts().resets > tracker_resets_seen_)
   {
     tracker_resets_seen_ = tracker_->counts().resets;
@@ -690,10 +769,29 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     if (now - start_wall_ >= h.stale_error && counters_.dropped_no_transform > 0)
       summary.level = core::HealthLevel::kError;
   }
+  // Inputs refused or bounded in the window warn, on top of the stream's own health.
+  const auto warn = [&](std::size_t n, const std::string& what) {
+    if (n == 0) return;
+    if (summary.level == core::HealthLevel::kOk) summary.level = core::HealthLevel::kWarn;
+    summary.message += "; " + std::to_string(n) + " " + what + " in the window";
+  };
+  warn(started_refused_window_.count(now), "scan_grid/started headers refused (see keys)");
+  warn(tracker_bounded_window_.count(now), "scans over the tracker's bounds (clutter)");
   status.summary(static_cast<unsigned char>(summary.level), summary.message);
+  diagnoseCounters(status, now);
+  diagnoseLatency(status, now);
+  diagnosePrior(status, now);
+  if (tracker_) diagnoseTracker(status, now);
+}
+
+void FusionWorker::diagnoseCounters(diagnostic_updater::DiagnosticStatusWrapper& status, double now)
+{
+  const core::StreamHealthParams& h = node_params_.health;
+  const std::size_t fused = fused_window_.count(now);
+  const double last = counters_.fused > 0 ? last_fused_wall_ : now;
   status.add("scan rate [Hz]", fused_window_.rate(now, start_wall_));
   status.add("scans fused in window", fused);
-  status.add("scans dropped or rejected in window", lost);
+  status.add("scans dropped or rejected in window", lost_window_.count(now));
   status.add("window [s]", h.diagnostic_window);
   status.add("seconds since last fused scan", counters_.fused > 0 ? now - last : -1.0);
   status.add("scans fused", counters_.fused);
@@ -714,8 +812,12 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("time prior window [ms]", 1e3 * last_times_.prior_window);
   status.add("time fusion [ms]", 1e3 * last_times_.fusion);
   status.add("time total with outputs [ms]", 1e3 * last_total_seconds_);
+}
+
+void FusionWorker::diagnoseLatency(diagnostic_updater::DiagnosticStatusWrapper& status, double now)
+{
   // Over the window: where a scan's time goes, from the cloud's stamp to its decision.
-  const auto quantiles = [&](const std::string& name, core::SlidingSamples& w) {
+  const auto quantiles = [&](const std::string& name, auto& w) {
     for (const auto& [q, label] : { std::pair<double, const char*>{ 0.5, " median [ms]" }, { 0.9, " p90 [ms]" } })
     {
       const double v = w.quantile(now, q);
@@ -727,6 +829,13 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   };
   quantiles("latency cloud to fusion callback", latency_.cloud_to_callback);
   quantiles("latency cloud to decision", latency_.cloud_to_decision);
+  // A stamp ahead of a lagging clock has no latency: counted here, not as a negative one.
+  status.add("scans stamped ahead of the clock in window", latency_.cloud_to_decision.aheadOfClock(now));
+  const double lead = latency_.cloud_to_decision.largestLead(now);
+  if (std::isnan(lead))
+    status.add("largest lead of a stamp over the clock [ms]", "none");
+  else
+    status.add("largest lead of a stamp over the clock [ms]", lead);
   quantiles("stage conversion", latency_.conversion);
   quantiles("stage shift", latency_.shift);
   quantiles("stage shift ahead", latency_.shift_ahead);
@@ -745,6 +854,10 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     else
       status.add(key, share);
   }
+}
+
+void FusionWorker::diagnosePrior(diagnostic_updater::DiagnosticStatusWrapper& status, double now)
+{
   status.add("mean conflict", last_mean_conflict_);
   status.add("memory [MiB]", grid_.params().bytesNeeded() / (1024.0 * 1024.0));
   status.add("prior", softener_.raw() ? "received" : "none (vacuous)");
@@ -761,8 +874,18 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("sigma clamped (over the bound)", counters_.sigma_clamped);
   status.add("prior softenings", counters_.prior_softenings);
   status.add("window shifts ahead (shift_ahead)", counters_.shifts_ahead);
+  status.add("started headers refused in window", started_refused_window_.count(now));
+  for (std::size_t v = 0; v < kStartedVerdicts; ++v)
+  {
+    const auto verdict = static_cast<core::StartedVerdict>(v);
+    if (verdict == core::StartedVerdict::kShift || verdict == core::StartedVerdict::kNoScanYet) continue;
+    status.add(std::string("started headers refused (") + core::toString(verdict) + ")", counters_.started_refused[v]);
+  }
   status.add("tracker", tracker_ ? "on" : "off");
-  if (tracker_)
+}
+
+void FusionWorker::diagnoseTracker(diagnostic_updater::DiagnosticStatusWrapper& status, double now)
+{
   {
     const core::TrackerCounts& c = tracker_->counts();
     status.add("tracks (last scan)", last_tracks_);
@@ -797,6 +920,11 @@ void FusionWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
     status.add("associations placed by an open end whose growth at the other end left their sigma", c.far_growth);
     status.add("measurements split off static background", c.split_measurements);
     status.add("tracker inputs skipped (non-finite)", c.non_finite_inputs);
+    status.add("scans over the tracker's bounds in window", tracker_bounded_window_.count(now));
+    status.add("measurements dropped (over tracker_max_measurements)", c.measurements_dropped);
+    status.add("clusters not tracked (over tracker_max_tracks)", c.tracks_refused);
+    status.add("most measurements in one scan", c.peak_measurements);
+    status.add("most tracks after one scan", c.peak_tracks);
   }
 }
 

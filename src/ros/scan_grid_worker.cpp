@@ -23,12 +23,9 @@ namespace {
 constexpr int kMaxQueueSize = 1000;
 constexpr double kMillisecondsPerSecond = 1000.0;
 
-/// Stamps the steady time into @p end when the callback that holds it returns.
-struct MarkBusyEnd
-{
-  std::atomic<double>& end;
-  ~MarkBusyEnd() { end = core::steadySeconds(); }
-};
+/// Clouds roscpp holds for the intake thread (onCloud takes microseconds, and waits at most for one build's lock):
+/// far more than arrive while a build holds the lock, so that none is lost there unseen.
+constexpr std::uint32_t kIntakeQueue = 200;
 constexpr double kMaxFutureTolerance = 3600.0;
 constexpr double kMinJumpThreshold = 0.001;
 constexpr double kMaxJumpThreshold = 3600.0;
@@ -131,8 +128,13 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
   grid_pub_ = nh_.advertise<EvidentialGrid>("scan_grid", 1);
   occupancy_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("scan_grid/occupancy", 1);
   started_pub_ = nh_.advertise<std_msgs::Header>("scan_grid/started", 1);
-  cloud_sub_ = nh_.subscribe("points", static_cast<std::uint32_t>(params_.input_queue_size), &ScanGridWorker::onCloud,
-                             this, ros::TransportHints().tcpNoDelay());
+  ros::SubscribeOptions intake = ros::SubscribeOptions::create<sensor_msgs::PointCloud2>(
+      "points", kIntakeQueue, [this](const sensor_msgs::PointCloud2ConstPtr& cloud) { onCloud(cloud); },
+      ros::VoidPtr(), &intake_queue_);
+  intake.transport_hints = ros::TransportHints().tcpNoDelay();
+  cloud_sub_ = nh_.subscribe(intake);
+  intake_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &intake_queue_);
+  intake_spinner_->start();
   active_ = true;
   const core::GridGeometry& g = builder_.geometry();
   ROS_INFO("scan_grid: %s -> %s and %s in %s, %d x %d cells of %.2f m, %d sectors",
@@ -143,6 +145,7 @@ ScanGridWorker::ScanGridWorker(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh
 ScanGridWorker::~ScanGridWorker()
 {
   cloud_sub_.shutdown();
+  if (intake_spinner_) intake_spinner_->stop();
   diagnostic_timer_.stop();
   clock_timer_.stop();
   tf_filter_.reset();
@@ -191,12 +194,18 @@ void ScanGridWorker::checkClock()
 
 void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
-  const MarkBusyEnd mark_end{ last_busy_end_ };
   checkClock();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.clouds_received;
     received_window_.add(core::steadySeconds());
+    // Every cloud received, rejected or not, is one the stream did not miss; a gap in the stamps is the stream's.
+    if (!cloud->header.stamp.isZero())
+      if (const std::size_t missing = gaps_.observe(cloud->header.stamp.toSec()); missing > 0)
+      {
+        stream_gaps_ += missing;
+        stream_gap_window_.add(core::steadySeconds(), missing);
+      }
     core::PointCloudView view;
     if (!viewOf(*cloud, view)) return;
     if (cloud->header.frame_id.empty())
@@ -222,26 +231,6 @@ void ScanGridWorker::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud)
       reject("before_time_jump", "stamped " + std::to_string(ahead) +
                                      " s ahead of a clock that went back: a cloud of before the jump");
       return;
-    }
-    if (const std::size_t lost = gaps_.observe(cloud->header.stamp.toSec()); lost > 0)
-    {
-      // Waiting idle for more than 1.5 periods means the queue was empty: the stream itself had the gap.
-      const double idle = core::steadySeconds() - last_busy_end_.load();
-      if (idle > core::InputGapCounter::kLostGapFactor * gaps_.period())
-      {
-        stream_gaps_ += lost;
-        stream_gap_window_.add(core::steadySeconds(), lost);
-      }
-      else
-      {
-        clouds_lost_ += lost;
-        lost_window_.add(core::steadySeconds(), lost);
-        ROS_WARN_THROTTLE(1.0, "scan_grid: %zu clouds on %s lost in the input queue (a stamp gap of %zu periods of "
-                               "%.3f s while busy): processing is slower than the input; raise input_queue_size (%d) "
-                               "or lighten the load; %zu so far",
-                          lost, cloud_sub_.getTopic().c_str(), lost + 1, gaps_.period(), params_.input_queue_size,
-                          clouds_lost_);
-      }
     }
     const std::string& frame = cloud->header.frame_id;
     const std::string source = tfFrame(frame);
@@ -287,7 +276,6 @@ void ScanGridWorker::onTransformFailure(const sensor_msgs::PointCloud2ConstPtr& 
 
 void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
-  const MarkBusyEnd mark_end{ last_busy_end_ };
   const ros::WallTime start = ros::WallTime::now();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!takePendingBuild(*cloud)) return;
@@ -499,6 +487,11 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     else
       status.add(std::string("latency cloud to grid published") + label, age);
   }
+  status.add("clouds stamped ahead of the clock in window", cloud_to_published_.aheadOfClock(now));
+  if (const double lead = cloud_to_published_.largestLead(now); std::isnan(lead))
+    status.add("largest lead of a stamp over the clock (ms)", "none");
+  else
+    status.add("largest lead of a stamp over the clock (ms)", lead);
   status.add("clouds received", counters_.clouds_received);
   status.add("clouds published", counters_.clouds_published);
   status.add("clouds rejected", counters_.clouds_rejected);

@@ -126,3 +126,63 @@ TEST(Assignment, EqualsBruteForceOnRandomGatedMatrices)
         }
   EXPECT_EQ(cases, 7 * 7 * 3 * 8);
 }
+
+namespace {
+
+/// The allowed pairs of @p m, in an order other than row-major (the sparse solver must not depend on it).
+SparseCosts sparseOf(const CostMatrix& m, std::mt19937& rng)
+{
+  SparseCosts s;
+  s.rows = m.rows;
+  s.cols = m.cols;
+  for (int r = 0; r < m.rows; ++r)
+    for (int c = 0; c < m.cols; ++c)
+      if (m.allowed(r, c)) s.pairs.push_back(GatedPair{ r, c, m.at(r, c) });
+  std::shuffle(s.pairs.begin(), s.pairs.end(), rng);
+  return s;
+}
+
+}  // namespace
+
+TEST(Assignment, SparsePairsGiveTheDenseMatrixsPairing)
+{
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> cost(0.0, 10.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int cases = 0;
+  for (int rows = 0; rows <= 12; rows += 3)
+    for (int cols = 0; cols <= 12; cols += 4)
+      for (double forbidden_share : { 0.0, 0.5, 0.9 })
+      {
+        CostMatrix m(rows, cols);
+        for (double& c : m.cost) c = u(rng) < forbidden_share ? kForbidden : cost(rng);
+        EXPECT_EQ(solveAssignment(sparseOf(m, rng)), solveAssignment(m)) << rows << "x" << cols;
+        ++cases;
+      }
+  EXPECT_EQ(cases, 5 * 4 * 3);
+  SparseCosts bad;
+  bad.rows = bad.cols = 2;
+  bad.pairs = { GatedPair{ 0, 2, 1.0 } };
+  EXPECT_THROW(solveAssignment(bad), std::invalid_argument);
+  bad.pairs = { GatedPair{ 1, 1, -0.5 } };
+  EXPECT_THROW(solveAssignment(bad), std::invalid_argument);
+  bad.pairs = { GatedPair{ 1, 1, kForbidden } };
+  EXPECT_EQ(solveAssignment(bad), (std::vector<int>{ -1, -1 }));
+}
+
+TEST(Assignment, ComponentsAboveTheExactBoundAreSolvedGreedilyAndCounted)
+{
+  // Two components: {rows 0, 1; columns 0, 1} (where greedy and the optimum differ, HandSolvedSquareCase) and
+  // {row 2; column 2}. With max_exact 1 the first is greedy: row 0 takes its cheapest column 0 (1), row 1 column 1
+  // (10); the single pair stays exact.
+  SparseCosts s;
+  s.rows = s.cols = 3;
+  s.pairs = { { 0, 0, 1.0 }, { 0, 1, 2.0 }, { 1, 0, 3.0 }, { 1, 1, 10.0 }, { 2, 2, 4.0 } };
+  std::size_t greedy = 0;
+  EXPECT_EQ(solveAssignment(s), (std::vector<int>{ 1, 0, 2 }));
+  EXPECT_EQ(solveAssignment(s, 1, &greedy), (std::vector<int>{ 0, 1, 2 }));
+  EXPECT_EQ(greedy, 1u);
+  greedy = 0;
+  EXPECT_EQ(solveAssignment(s, 2, &greedy), (std::vector<int>{ 1, 0, 2 }));
+  EXPECT_EQ(greedy, 0u);
+}

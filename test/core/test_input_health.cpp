@@ -81,6 +81,26 @@ TEST(InputHealth, LostInputsCountedFromStampGapsWithALearntPeriod)
   EXPECT_NEAR(c.period(), 0.1, 1e-9) << "the outage must not become the period";
 }
 
+TEST(InputHealth, AStampOutOfOrderMidStreamMissesNothing)
+{
+  // 10 Hz; one cloud stamped 0.5 s back between two on time (a second source, a late cloud): no gap is invented
+  // after it, and the stream goes on from the newest stamp.
+  InputGapCounter c(0.1);
+  double t = 10.0;
+  EXPECT_EQ(c.observe(t), 0u);
+  EXPECT_EQ(c.observe(t += 0.1), 0u);
+  EXPECT_EQ(c.observe(t - 0.5), 0u);
+  EXPECT_EQ(c.observe(t += 0.1), 0u);
+  EXPECT_EQ(c.observe(t), 0u);  // a duplicate
+  EXPECT_EQ(c.observe(t += 0.1), 0u);
+  EXPECT_EQ(c.lost(), 0u);
+  // A real gap after it still counts; a loop far back (more than 100 periods) restarts from its stamp.
+  EXPECT_EQ(c.observe(t += 0.3), 2u);
+  EXPECT_EQ(c.observe(t - 60.0), 0u);
+  EXPECT_EQ(c.observe(t - 60.0 + 0.1), 0u);
+  EXPECT_EQ(c.lost(), 2u);
+}
+
 TEST(InputHealth, LostInputsWithAConfiguredPeriod)
 {
   InputGapCounter c(0.05);  // 20 Hz

@@ -72,6 +72,44 @@ TEST(ClockJumpDetector, ReportsEachBackwardJumpOnce)
   EXPECT_FALSE(d.observe(std::nan("")));
 }
 
+TEST(StartedHeader, OnlyAHeaderOfAScanThatWillBeFusedMovesTheWindow)
+{
+  TimeGuardParams p;
+  p.max_plausible_speed = 20.0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  StartedReference none;  // no scan fused yet
+  EXPECT_EQ(checkStarted(none, "base_link", 10.0, true, 0.0, 0.0, p), StartedVerdict::kNoScanYet);
+  StartedReference ref;
+  ref.frame = "base_link";
+  ref.fused_stamp = 10.0;
+  ref.fused_x = 100.0;
+  ref.fused_y = 50.0;
+  // 1 m in 0.1 s (10 m/s): the scan the ScanGrid announced.
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.1, true, 101.0, 50.0, p), StartedVerdict::kShift);
+  // A fixed frame resolves at any stamp, at its own origin: the window would leave the vehicle.
+  EXPECT_EQ(checkStarted(ref, "map", 10.1, true, 0.0, 0.0, p), StartedVerdict::kOtherFrame);
+  EXPECT_EQ(checkStarted(ref, "odom", 10.1, true, 101.0, 50.0, p), StartedVerdict::kOtherFrame);
+  // Stamps: 0, not finite, refused by the caller's clock checks, not newer than the fused scan or the last shift.
+  EXPECT_EQ(checkStarted(ref, "base_link", 0.0, true, 100.0, 50.0, p), StartedVerdict::kBadStamp);
+  EXPECT_EQ(checkStarted(ref, "base_link", nan, true, 100.0, 50.0, p), StartedVerdict::kBadStamp);
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.1, false, 101.0, 50.0, p), StartedVerdict::kBadStamp);
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.0, true, 100.0, 50.0, p), StartedVerdict::kNotNewer);
+  EXPECT_EQ(checkStarted(ref, "base_link", 9.5, true, 100.0, 50.0, p), StartedVerdict::kNotNewer);
+  ref.shifted_stamp = 10.2;
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.15, true, 101.0, 50.0, p), StartedVerdict::kNotNewer);
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.3, true, 103.0, 50.0, p), StartedVerdict::kShift);
+  // No pose at its stamp, or one the vehicle cannot have reached: 2.1 m in 0.1 s is 21 m/s.
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.3, true, nan, 50.0, p), StartedVerdict::kNoTransform);
+  ref.shifted_stamp.reset();
+  EXPECT_EQ(checkStarted(ref, "base_link", 10.1, true, 100.0, 52.1, p), StartedVerdict::kImplausible);
+  // A second later (a lidar pause), 19 m is plausible: the window follows the vehicle as the scan will.
+  EXPECT_EQ(checkStarted(ref, "base_link", 11.0, true, 119.0, 50.0, p), StartedVerdict::kShift);
+  for (const StartedVerdict v : { StartedVerdict::kShift, StartedVerdict::kNoScanYet, StartedVerdict::kOtherFrame,
+                                  StartedVerdict::kBadStamp, StartedVerdict::kNotNewer, StartedVerdict::kImplausible,
+                                  StartedVerdict::kNoTransform })
+    EXPECT_STRNE(toString(v), "?");
+}
+
 TEST(PoseJump, SpeedFromDistanceAndTime)
 {
   const PoseJump slow = checkPoseJump(0, 0, 10.0, 3, 4, 10.1, 70.0);
@@ -123,6 +161,24 @@ TEST(SlidingSamples, NearestRankQuantilesOfTheWindowOnly)
   EXPECT_EQ(s.quantile(5.45, 0.5), 8.0);
   EXPECT_EQ(s.count(7.0), 0u) << "the slow sample leaves too";
   EXPECT_TRUE(std::isnan(s.quantile(7.0, 0.9)));
+}
+
+TEST(LatencyWindow, AStampAheadOfTheClockIsCountedWithItsLeadNeverANegativeLatency)
+{
+  LatencyWindow w(5.0);
+  w.add(1.0, 30.0);
+  w.add(2.0, -200.0);   // a /clock lagging 0.2 s behind the data
+  w.add(3.0, -1856.0);
+  w.add(3.5, std::nan(""));
+  w.add(4.0, 10.0);
+  EXPECT_DOUBLE_EQ(w.quantile(4.0, 0.5), 10.0);  // nearest rank of {10, 30}
+  EXPECT_DOUBLE_EQ(w.quantile(4.0, 0.0), 10.0);
+  EXPECT_EQ(w.aheadOfClock(4.0), 2u);
+  EXPECT_DOUBLE_EQ(w.largestLead(4.0), 1856.0);
+  // The window moves on: the leads leave it, the latency of t = 4 stays.
+  EXPECT_EQ(w.aheadOfClock(8.5), 0u);
+  EXPECT_TRUE(std::isnan(w.largestLead(8.5)));
+  EXPECT_DOUBLE_EQ(w.quantile(8.5, 0.9), 10.0);
 }
 
 TEST(SlidingCounter, CountsOnlyTheWindowAndDecays)

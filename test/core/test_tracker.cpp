@@ -81,6 +81,117 @@ void expectRefusedByName(const std::vector<std::pair<std::string, void (*)(Track
 
 }  // namespace
 
+TEST(Tracker, ReturnsFarOutOfRangeAreNoClusterAndNoUndefinedCast)
+{
+  // fuzz_tracker's first find: a pose 10¹⁹ m out put the returns' cells beyond a 64-bit index (an undefined cast,
+  // caught by the sanitizers). They form no cluster; a track far out is still associated through the grid.
+  TrackerParams p;
+  p.min_cluster_points = 4;
+  Tracker tracker(p);
+  const std::vector<float> xy{ 5.0f, 0.0f, 5.1f, 0.0f, 5.0f, 0.1f, 5.1f, 0.1f };
+  tracker.update(1.0, Pose2{ -1.1e19, 3e18, 0.0 }, ObstaclePoints{ xy.data(), 4 });
+  EXPECT_TRUE(tracker.measurements().empty());
+  EXPECT_TRUE(tracker.tracks().empty());
+  Tracker far;
+  far.update(2.0, { at(1e17, -1e17) });
+  far.update(2.1, { at(1e17, -1e17) });
+  ASSERT_EQ(far.tracks().size(), 1u);
+  EXPECT_EQ(far.tracks()[0].hits, 2);
+}
+
+TEST(Tracker, AResetFromOutsideIsCountedAndForgetsTheLastStampAndFreeSpace)
+{
+  Tracker tracker;
+  tracker.update(5.0, { at(0, 0) });
+  tracker.reset();  // as the fusion does on a time jump
+  EXPECT_EQ(tracker.counts().resets, 1u);
+  EXPECT_TRUE(tracker.tracks().empty());
+  // The next loop starts earlier: no second reset, and the new measurement starts a track.
+  tracker.update(1.0, { at(0, 0) });
+  EXPECT_EQ(tracker.counts().resets, 1u);
+  EXPECT_EQ(tracker.tracks().size(), 1u);
+}
+
+namespace {
+
+/// @p n measurements on a line away from the sensor at the origin, 10 m apart (measurement i at 10 (i + 1) m).
+std::vector<Measurement> lineAwayFromSensor(int n)
+{
+  std::vector<Measurement> out;
+  for (int i = 0; i < n; ++i)
+  {
+    Measurement m = withExtent(at(10.0 * (i + 1), 0.0), 1.0, 1.0);
+    m.has_sensor = true;
+    out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Tracker, MeasurementsOverTheBoundAreTheFarthestDroppedAndCounted)
+{
+  TrackerParams p;
+  p.max_measurements = 3;
+  Tracker tracker(p);
+  std::vector<Measurement> scan = lineAwayFromSensor(5);
+  std::swap(scan[0], scan[4]);  // the nearest last: the order given is not the order kept
+  tracker.update(1.0, scan);
+  ASSERT_EQ(tracker.measurements().size(), 3u);
+  // The three nearest (10, 20, 30 m), in the order given (50 m went to the front, 10 m to the back).
+  EXPECT_DOUBLE_EQ(tracker.measurements()[0].centroid.x, 20.0);
+  EXPECT_DOUBLE_EQ(tracker.measurements()[1].centroid.x, 30.0);
+  EXPECT_DOUBLE_EQ(tracker.measurements()[2].centroid.x, 10.0);
+  EXPECT_EQ(tracker.counts().measurements_dropped, 2u);
+  EXPECT_EQ(tracker.counts().peak_measurements, 5u);
+  EXPECT_EQ(tracker.tracks().size(), 3u);
+}
+
+TEST(Tracker, TracksOverTheBoundAreNotStartedTheNearestFirstAndCounted)
+{
+  TrackerParams p;
+  p.max_tracks = 4;
+  Tracker tracker(p);
+  tracker.update(1.0, lineAwayFromSensor(3));
+  ASSERT_EQ(tracker.tracks().size(), 3u);
+  // Three tracks kept (associated again), room for one of the three new clusters beyond: the nearest, at 40 m.
+  tracker.update(1.1, lineAwayFromSensor(6));
+  ASSERT_EQ(tracker.tracks().size(), 4u);
+  EXPECT_NEAR(tracker.tracks().back().position().x, 40.0, 1e-9);
+  EXPECT_EQ(tracker.counts().tracks_refused, 2u);
+  EXPECT_EQ(tracker.counts().peak_tracks, 4u);
+  p.max_tracks = 0;
+  EXPECT_THROW(p.validate(), ParameterError);
+  p = TrackerParams{};
+  p.max_measurements = 2000000;
+  EXPECT_THROW(p.validate(), ParameterError);
+}
+
+TEST(Tracker, TheAssociationsGridFindsEveryPairTheGateAllows)
+{
+  // Objects of every size, 0.5 to 18 m long, at random places and headings, moved by up to the gate's distance:
+  // each keeps its id whether the others are near or far (the grid's cells are max_gate_distance wide, and a long
+  // object's followed point lies far from its cluster's centroid).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> where(-60.0, 60.0), size(0.5, 18.0), turn(-M_PI, M_PI), step(-1.5, 1.5);
+  std::vector<Measurement> scan;
+  for (int i = 0; i < 40; ++i)
+  {
+    Measurement m = withExtent(at(where(rng), where(rng), 0.1), size(rng), 1.0 + 0.1 * (i % 20));
+    m.yaw = turn(rng);
+    scan.push_back(m);
+  }
+  Tracker tracker;
+  tracker.update(1.0, scan);
+  std::vector<std::uint32_t> ids;
+  for (const Track& t : tracker.tracks()) ids.push_back(t.id);
+  for (Measurement& m : scan) m.centroid = Point2{ m.centroid.x + step(rng), m.centroid.y + step(rng) };
+  tracker.update(1.1, scan);
+  ASSERT_EQ(tracker.tracks().size(), ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) EXPECT_EQ(tracker.tracks()[k].id, ids[k]);
+  EXPECT_EQ(tracker.counts().tracks_created, ids.size());
+}
+
 TEST(Tracker, ParametersAreValidatedByName)
 {
   TrackerParams p;
@@ -256,13 +367,25 @@ TEST(Tracker, BadInputNeverReachesATrack)
   singular.covariance.setZero();
   Measurement inf_cov = at(2, 2);
   inf_cov.covariance(0, 0) = std::numeric_limits<double>::infinity();
-  tracker.update(0.0, { nan_centroid, singular, inf_cov, at(3, 3) });
+  Measurement nan_yaw = at(4, 4);
+  nan_yaw.yaw = std::nan("");
+  Measurement huge_box = withExtent(at(5, 5), 1.0, 1.0);
+  huge_box.hi_u = 1e300;  // a box no object has: its middle would overflow
+  Measurement nan_sensor = at(6, 6);
+  nan_sensor.has_sensor = true;
+  nan_sensor.sensor.x = std::nan("");
+  Measurement negative_definite = at(7, 7);
+  negative_definite.covariance = -negative_definite.covariance;  // determinant > 0: fuzz_tracker's second find
+  Measurement asymmetric = at(8, 8);
+  asymmetric.covariance(0, 1) = 0.01;
+  tracker.update(0.0, { nan_centroid, singular, inf_cov, nan_yaw, huge_box, nan_sensor, negative_definite, asymmetric,
+                        at(3, 3) });
   ASSERT_EQ(tracker.tracks().size(), 1u);
-  EXPECT_EQ(tracker.counts().non_finite_inputs, 3u);
+  EXPECT_EQ(tracker.counts().non_finite_inputs, 8u);
   const std::vector<float> xy{ std::nanf(""), 0.0f };
   tracker.update(0.1, Pose2{ 0, 0, std::nan("") }, ObstaclePoints{ xy.data(), 1 });
   tracker.update(0.2, Pose2{ 0, 0, 0 }, ObstaclePoints{ xy.data(), 1 });
-  EXPECT_EQ(tracker.counts().non_finite_inputs, 5u);
+  EXPECT_EQ(tracker.counts().non_finite_inputs, 10u);
   for (const Track& t : tracker.tracks())
   {
     EXPECT_TRUE(t.x.allFinite());

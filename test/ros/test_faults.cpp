@@ -19,6 +19,7 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Header.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
@@ -406,6 +407,7 @@ TEST(Faults, Item12_BlindLidarIsReportedNotFusedAndTheGridKept)
   const double fused = probe->value("fusion", "scans fused");
   const double non_finite = std::max(0.0, probe->value("scan_grid", "clouds rejected: blind_non_finite"));
   const double empty = std::max(0.0, probe->value("scan_grid", "clouds rejected: blind_empty"));
+  const double lost = std::max(0.0, probe->value("scan_grid", "clouds lost in the input queue"));
   // 4 s of all-NaN sweeps, then 1 s of empty ones, at 10 Hz with the vehicle's poses.
   bool warned = false;
   for (int k = 0; k < 50; ++k)
@@ -426,6 +428,8 @@ TEST(Faults, Item12_BlindLidarIsReportedNotFusedAndTheGridKept)
   EXPECT_GE(probe->value("scan_grid", "clouds rejected: blind_non_finite") - non_finite, 35.0);
   EXPECT_GE(probe->value("scan_grid", "clouds rejected: blind_empty") - empty, 8.0);
   EXPECT_EQ(probe->value("fusion", "scans fused"), fused) << "a blind cloud reached the MapGrid";
+  EXPECT_EQ(std::max(0.0, probe->value("scan_grid", "clouds lost in the input queue")), lost)
+      << "every blind cloud was received and handled: none was lost in the input queue";
   EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
   // Sight returns: the decided cells were kept, and the blind spell is over.
   drive(3);
@@ -437,23 +441,22 @@ TEST(Faults, Item12_BlindLidarIsReportedNotFusedAndTheGridKept)
 TEST(Faults, Item13_CloudsLostInAFullInputQueueAreCountedAndWarned)
 {
   setUpPipeline();
-  drive(3);
+  drive(10);  // transforms over the last 1.2 s, which the burst's stamps fall in
   probe->spinFor(0.5);
-  // A burst far faster than the ScanGrid (input_queue_size 2) takes: stamps 0.1 s apart, older than the fused scans
-  // so that the fusion drops them (released late) and its state is left alone. The first is sent alone and built,
-  // so that every later cloud follows one the ScanGrid has seen: each is then either built or counted lost, whether
-  // the subscriber's queue or the build backlog dropped it.
-  const ros::Time base = ros::Time::now() - ros::Duration(8.0);
+  // A burst far faster than the ScanGrid (input_queue_size 2) builds, received whole by its intake thread: every
+  // cloud is either built or counted lost where the backlog drops it, whatever the scheduling. Stamped 0.9 to 0.6 s
+  // before the last fused scan, 5 ms apart: the fusion drops them as out of order (older by less than
+  // time_jump_threshold), however long the builds take, so that its state is left alone and no reset can follow.
+  const ros::Time base = last_stamp - ros::Duration(0.9);
   constexpr int kBurst = 60;
   std::vector<sensor_msgs::PointCloud2> burst;
   for (int k = 0; k <= kBurst; ++k) burst.push_back(makeCloud({ Box{ 8.0, 3.0, 12.5, 5.0, 1.5 } },
-                                                              base + ros::Duration(0.1 * k)));
+                                                              base + ros::Duration(0.005 * k)));
   const auto settled = [&](const char* key) {
     probe->spinFor(kSettle);
     return probe->value("scan_grid", key);
   };
-  // The first cloud's build is seen on the ScanGrid's output (at once, unlike the diagnostics): the whole burst stays
-  // well within the fusion's time_jump_threshold of wall time, so that its late scans are not read as a bag loop.
+  // The first cloud is sent alone and built (seen on the ScanGrid's output, at once, unlike the diagnostics).
   std::atomic<bool> first_built{ false };
   ros::NodeHandle nh;
   ros::Subscriber grids = nh.subscribe<nav_msgs::OccupancyGrid>(
@@ -536,6 +539,57 @@ TEST(BagLoop, ThreeLoopsResetOnceEachAndLoseNoScan)
   EXPECT_GE(probe->messages("fusion"), n + 2) << "diagnostics stopped";
   EXPECT_TRUE(probe->waitFor([] { return probe->level("fusion") != diagnostic_msgs::DiagnosticStatus::OK; }, 4.0))
       << "OK while nothing is fused: " << probe->message("fusion");
+}
+
+TEST(Faults, Item16_AStartedHeaderOfNoScanToFuseIsRefusedAndTheGridKept)
+{
+  setUpPipeline();
+  drive(5);
+  probe->spinFor(0.5);
+  const std::size_t known = probe->knownCells();
+  ASSERT_GT(known, 100u);
+  const double shifts = std::max(0.0, probe->value("fusion", "window shifts ahead (shift_ahead)"));
+  const double frame0 = std::max(0.0, probe->value("fusion", "started headers refused (other frame)"));
+  const double implausible0 = std::max(0.0, probe->value("fusion", "started headers refused (implausible pose)"));
+  // A fixed frame 400 m away resolves at any stamp: during a 1 s lidar pause, 100 Hz of `started` headers in it
+  // (a ScanGrid configured in that frame, a replayed topic), then as many in the vehicle's frame whose pose jumped
+  // 400 m. Followed, either would move the window off the vehicle and drop every cell it had.
+  geometry_msgs::TransformStamped far;
+  far.header.frame_id = "map";
+  far.header.stamp = ros::Time::now();
+  far.child_frame_id = "elsewhere";
+  far.transform.translation.x = 400.0;
+  far.transform.rotation.w = 1.0;
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  broadcaster.sendTransform(far);
+  ros::NodeHandle nh;
+  ros::Publisher started = nh.advertise<std_msgs::Header>("/map_aided_fusion/scan_grid/started", 100);
+  ASSERT_TRUE(probe->waitFor([&] { return started.getNumSubscribers() > 0; }, 5.0));
+  probe->spinFor(0.3);
+  constexpr int kHeaders = 50;
+  for (int k = 0; k < 2 * kHeaders; ++k)
+  {
+    std_msgs::Header h;
+    h.stamp = ros::Time::now();
+    h.frame_id = k < kHeaders ? "elsewhere" : "base_link";
+    if (k >= kHeaders) probe->sendPose(h.stamp, 400.0);
+    probe->spinFor(0.005);
+    started.publish(h);
+    probe->spinFor(0.005);
+  }
+  EXPECT_TRUE(probe->waitFor(
+      [&] { return probe->value("fusion", "started headers refused (other frame)") - frame0 >= kHeaders * 0.9 &&
+                   probe->value("fusion", "started headers refused (implausible pose)") - implausible0 > 0.0 &&
+                   probe->level("fusion") >= diagnostic_msgs::DiagnosticStatus::WARN; },
+      kSettle))
+      << probe->message("fusion");
+  EXPECT_NE(probe->message("fusion").find("started headers refused"), std::string::npos) << probe->message("fusion");
+  EXPECT_EQ(probe->value("fusion", "window shifts ahead (shift_ahead)"), shifts);
+  // The lidar comes back where the vehicle really is: its evidence is all there.
+  drive(3);
+  probe->spinFor(0.5);
+  EXPECT_GE(probe->knownCells(), known * 9 / 10) << "a refused header moved the window";
+  EXPECT_EQ(probe->value("fusion", "grid resets (time jump)"), 0.0);
 }
 
 TEST(Faults, Item15_EveryMistakeNamesItsCause)

@@ -6,6 +6,7 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 namespace map_aided_fusion {
@@ -39,6 +40,36 @@ struct CostMatrix
  * @throws std::invalid_argument when the matrix's size does not match rows × cols, or an allowed cost is negative.
  */
 std::vector<int> solveAssignment(const CostMatrix& m);
+
+/// An allowed pair of a sparse problem: row, column and its cost (≥ 0; ≥ kForbidden or not finite: not allowed).
+struct GatedPair
+{
+  int row = 0;
+  int col = 0;
+  double cost = 0.0;
+};
+
+/// A rows × columns problem given by its allowed pairs only (each pair at most once): what a gate leaves.
+struct SparseCosts
+{
+  int rows = 0;
+  int cols = 0;
+  std::vector<GatedPair> pairs;
+};
+
+/**
+ * @brief The same problem as solveAssignment(const CostMatrix&), given by its allowed pairs: the pairing of the
+ *        largest number of pairs and, among those, the least total cost; the same result as the dense matrix with
+ *        those pairs allowed. Its cost grows with the pairs and the size of the components they link (solved one
+ *        by one), not with rows × cols.
+ * @param max_exact a component whose smaller side (rows or columns) is larger is solved greedily instead, the
+ *        cheapest allowed pairs first (a bound on the cubic cost: clutter where every object gates with its
+ *        neighbours), and counted in @p greedy when given. The default: every component exact.
+ * @return for each row, the column it is paired with, or −1.
+ * @throws std::invalid_argument when a pair lies outside rows × cols or has a negative cost.
+ */
+std::vector<int> solveAssignment(SparseCosts m, std::size_t max_exact = static_cast<std::size_t>(-1),
+                                 std::size_t* greedy = nullptr);
 
 /// Total cost of an assignment returned by solveAssignment() (allowed pairs only).
 double assignmentCost(const CostMatrix& m, const std::vector<int>& row_to_col);

@@ -2,8 +2,8 @@
  * @file input_health.hpp
  * @brief Health of a lidar's input stream, ROS-free: a blind cloud (no or too few valid returns) is told apart
  *        from a scene, and clouds missing from the stream are counted from the gaps between the stamps that did
- *        arrive: lost in a full input queue when the node was busy, missing upstream (a paused player, a driver
- *        that skips) when it was idle.
+ *        arrive (upstream: a paused player, a driver that skips, the network). Clouds the node discards itself
+ *        (a full input queue) it counts one by one where it discards them, never from the stamps.
  *
  * A blind cloud must not be fused: the ScanGrid of a cloud without returns says "free nowhere, occupied
  * nowhere" only by accident of the sensor model, and a few stray returns would carve free space that was never
@@ -33,7 +33,7 @@ struct InputHealthParams
   int min_valid_returns = 50;
   /**
    * Expected time between clouds (s): a gap of more than 1.5 periods between two received stamps counts the
-   * clouds that should have come in it as lost. 0: learnt from the stream (the shortest of the last 20 gaps).
+   * clouds that should have come in it as missing from the stream. 0: learnt from the stream (the shortest of the last 20 gaps).
    * In [0, 10].
    */
   double input_period = 0.0;
@@ -96,12 +96,14 @@ private:
 };
 
 /**
- * @brief Counts inputs missing from a stream, from the gaps between the stamps that arrived (the caller tells
- *        losses in its own input queue from gaps in the stream itself).
+ * @brief Counts inputs missing from a stream, from the gaps between the stamps that arrived (every input received
+ *        is observed, whatever becomes of it: inputs a node discards itself it counts one by one, apart).
  *
  * With a configured period T (or, when T is 0, the shortest of the last kLearnedGaps gaps between consecutive
- * stamps, which lost inputs can only lengthen), a gap g > 1.5 T means round(g / T) − 1 inputs were lost. Stamps
- * that do not advance (duplicates, out of order, a time jump) restart the count without judging.
+ * stamps, which lost inputs can only lengthen), a gap g > 1.5 T means round(g / T) − 1 inputs were missing. A stamp
+ * that does not advance (a duplicate, an input out of order) is not judged and leaves the reference at the newest
+ * stamp; one older than it by more than kOutageFactor periods (a looping bag, a restarted source), or any older one
+ * while the period is unknown, restarts the count.
  */
 class InputGapCounter
 {
@@ -114,11 +116,11 @@ public:
   static constexpr double kOutageFactor = 100.0;
 
   explicit InputGapCounter(double period = 0.0) : configured_(period) {}
-  /// Inputs lost between the previous stamp and @p stamp (seconds).
+  /// Inputs missing between the newest stamp so far and @p stamp (seconds).
   std::size_t observe(double stamp);
   /// The period in force (configured or learnt), 0 while unknown.
   double period() const;
-  /// Inputs judged lost since construction.
+  /// Inputs judged missing since construction.
   std::size_t lost() const { return lost_; }
 
 private:

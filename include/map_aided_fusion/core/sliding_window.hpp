@@ -127,6 +127,43 @@ private:
   std::deque<Sample> samples_;
 };
 
+/**
+ * @brief The age of data (ms since its stamp) when a stage is done, over a sliding window. An age is a latency only
+ *        when it is not negative: a stamp ahead of the clock (a `/clock` lagging behind the data) gives no latency
+ *        sample; it is counted, with its lead over the clock, apart.
+ */
+class LatencyWindow
+{
+public:
+  /// @param span window length, seconds (> 0)
+  explicit LatencyWindow(double span = 5.0) : ages_(span), leads_(span) {}
+
+  void setSpan(double span)
+  {
+    ages_.setSpan(span);
+    leads_.setSpan(span);
+  }
+
+  /// Records at time @p t an age of @p age_ms (NaN: nothing).
+  void add(double t, double age_ms)
+  {
+    if (age_ms >= 0.0)
+      ages_.add(t, age_ms);
+    else if (age_ms < 0.0)
+      leads_.add(t, -age_ms);
+  }
+
+  /// The nearest-rank @p q-quantile of the latencies in the window (SlidingSamples::quantile()); NaN without one.
+  double quantile(double now, double q) { return ages_.quantile(now, q); }
+  /// Data stamped ahead of the clock in the window.
+  std::size_t aheadOfClock(double now) { return leads_.count(now); }
+  /// The largest lead of a stamp over the clock in the window, ms; NaN without one.
+  double largestLead(double now) { return leads_.quantile(now, 1.0); }
+
+private:
+  SlidingSamples ages_, leads_;
+};
+
 /// Parameters of the diagnostics of a node that expects a stream of scans (config/*.yaml).
 struct StreamHealthParams
 {

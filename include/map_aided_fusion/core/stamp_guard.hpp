@@ -10,6 +10,7 @@
  */
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -144,6 +145,42 @@ struct PoseJump
 
 /// Distance and speed between (x0, y0) at t0 and (x1, y1) at t1, judged against @p max_speed.
 PoseJump checkPoseJump(double x0, double y0, double t0, double x1, double y1, double t1, double max_speed);
+
+
+/// What the fusion does with a `scan_grid/started` header (FusionNodeParams::shift_ahead), checkStarted().
+enum class StartedVerdict : std::uint8_t
+{
+  kShift,        ///< it announces a scan the fusion will fuse: move the window now
+  kNoScanYet,    ///< no scan fused yet, so no frame to compare: nothing to move (not counted as a refusal)
+  kOtherFrame,   ///< not the frame of the fused scans (a fixed frame, `map` or `odom`, moves the window to its origin)
+  kBadStamp,     ///< stamped 0, not finite, or further ahead of the clock than the scans may be
+  kNotNewer,     ///< not newer than the last fused scan and the last header honoured: a scan the fusion would drop
+  kImplausible,  ///< its pose lies further from the last fused one than max_plausible_speed allows in the time between
+  kNoTransform,  ///< tf has no finite pose of its frame at its stamp
+};
+
+/// A short name for logs and diagnostics ("shift", "no scan yet", "other frame", …).
+const char* toString(StartedVerdict v);
+
+/// The last fused scan, and the last `started` header honoured, against which checkStarted() judges a header.
+struct StartedReference
+{
+  std::string frame;             ///< frame of the fused scans ("" before the first)
+  double fused_stamp = 0.0;      ///< s, stamp of the last fused scan
+  double fused_x = 0.0, fused_y = 0.0;  ///< m, map frame: the vehicle there
+  std::optional<double> shifted_stamp;  ///< s, the last header honoured since (none: none)
+};
+
+/**
+ * @brief The verdict on a `started` header in @p frame at @p stamp whose vehicle position in the map frame is
+ *        (@p x, @p y) (NaN when tf has none). It is honoured only when it describes a scan the fusion will fuse:
+ *        the frame of its scans, a stamp newer than the last fused scan and than the last header honoured
+ *        (@p stamp_ok: the caller's own stamp checks, zero and ahead of the clock, passed), and a position reachable
+ *        from the last fused one at max_plausible_speed (@p params). A window so moved is one the scan itself would
+ *        have moved to: a header whose scan never comes costs at most the cells a vehicle at that speed leaves.
+ */
+StartedVerdict checkStarted(const StartedReference& ref, const std::string& frame, double stamp, bool stamp_ok,
+                            double x, double y, const TimeGuardParams& params);
 
 }  // namespace core
 }  // namespace map_aided_fusion

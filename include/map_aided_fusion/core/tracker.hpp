@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include "map_aided_fusion/core/assignment.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
@@ -25,6 +26,11 @@
 
 namespace map_aided_fusion {
 namespace core {
+
+/// Default TrackerParams::max_measurements and max_tracks: about six times the most seen in one scan of any dataset
+/// (KITTI tracking 0000: 170 measurements, 185 tracks; SemanticKITTI 06: 140 and 158; doc/reliability.md).
+constexpr int kDefaultMaxMeasurements = 1000;
+constexpr int kDefaultMaxTracks = 1000;
 
 /// The tracker's parameters (config/fusion.yaml, `tracker_*`); units in the comments.
 struct TrackerParams
@@ -77,6 +83,11 @@ struct TrackerParams
   /// the pieces' returns take the track's motion (Track::fragments, step track evidence).
   bool duplicates = true;
   double max_coast_time = 0.5;       ///< s without an association before a confirmed track is deleted
+  /// The bounds of a scan's cost (rain, a flock of birds, a street lined with hedges): at most max_measurements
+  /// measurements a scan, the nearest to the sensor (the others are dropped and counted), and at most max_tracks
+  /// tracks (clusters that would start one beyond are counted, not tracked; the nearest start first).
+  int max_measurements = kDefaultMaxMeasurements;
+  int max_tracks = kDefaultMaxTracks;
   double moving_speed = 0.5;         ///< m/s: moving when speed − motion_sigmas · σ(speed) is above this
   double motion_sigmas = 1.5;        ///< how many standard deviations the speed must clear
   double stopped_speed = 0.8;        ///< m/s: stopped when speed + motion_sigmas · σ(speed) stays below this …
@@ -289,6 +300,8 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_duplicates", p.duplicates, { "", "step duplicates: a moving track whose object box centre lies in the object box of a moving track with more hits (grown by tracker_fragment_margin), moving within 60° of its heading, is deleted; its cluster and the fragments take that track's motion" });
   get("tracker_fragment_margin", p.fragment_margin, { "m", "how far beyond a moving track's box a cluster is a fragment of it (step fragments)" });
   get("tracker_max_coast_time", p.max_coast_time, { "s", "time without an association before a confirmed track is deleted" });
+  get("tracker_max_measurements", p.max_measurements, { "measurements", "a scan's measurements beyond this, the farthest from the sensor, are dropped and counted" });
+  get("tracker_max_tracks", p.max_tracks, { "tracks", "clusters that would start a track beyond this many tracks are counted, not tracked" });
   get("tracker_moving_speed", p.moving_speed, { "m/s", "moving when speed − motion_sigmas·σ(speed) is above this" });
   get("tracker_motion_sigmas", p.motion_sigmas, { "", "standard deviations the speed must clear to call a motion state" });
   get("tracker_stopped_speed", p.stopped_speed, { "m/s", "stopped when speed + motion_sigmas·σ(speed) stays below this for stopped_time" });
@@ -525,7 +538,12 @@ struct TrackerCounts
   std::uint64_t box_fit = 0;      ///< measurements whose fitted axes are more than box_fit_step off their principal ones (step box fit)
   std::uint64_t open_anchor = 0;  ///< associations with a cluster placed by its open anchoring end (step open anchor)
   std::uint64_t far_growth = 0;   ///< ... of them whose change of length left their σ as it was (step far growth)
-  std::uint64_t non_finite_inputs = 0;  ///< non-finite returns or poses skipped
+  std::uint64_t non_finite_inputs = 0;  ///< non-finite returns, poses or measurements (or boxes beyond 10⁶ m) skipped
+  std::uint64_t measurements_dropped = 0;  ///< measurements over max_measurements in their scan, dropped
+  std::uint64_t tracks_refused = 0;        ///< clusters that would have started a track beyond max_tracks
+  std::uint64_t greedy_associations = 0;   ///< gated components too large for the exact assignment, solved greedily
+  std::uint64_t peak_measurements = 0;     ///< the most measurements of one scan (before max_measurements)
+  std::uint64_t peak_tracks = 0;           ///< the most tracks after one scan
 };
 
 /**
@@ -610,11 +628,25 @@ public:
   }
   /// The speed the motion decision takes: relative to the common motion at the track.
   double decisionSpeed(const Track& t) const { return t.speedRelativeTo(commonMotionAt(t.position())); }
-  /// Drops every track (ids keep counting up).
+  /// Drops every track and the free space of earlier scans, forgets the last stamp, and counts a reset
+  /// (TrackerCounts::resets; ids keep counting up). Called on a time jump or a pose jump.
   void reset();
 
 private:
   void predict(Track& t, double dt) const;
+  /// Keeps the max_measurements of @p found nearest the sensor (counted); records the peak.
+  void capMeasurements(std::vector<Measurement>& found);
+  /// Predicted tracks × measurements_: the gated global assignment and the corrections; which measurements it used.
+  std::vector<char> associate(double stamp);
+  /// The measurements of this scan that no track took and that are no fragment start tracks in @p kept, within
+  /// max_tracks (the nearest first; the others counted).
+  void startTracks(std::vector<Track>& kept, const std::vector<char>& used, double stamp);
+  /// A new tentative track on @p z (measurement index @p measurement) at @p stamp.
+  Track newTrack(const Measurement& z, int measurement, double stamp);
+  /// The gated pairs of this scan's tracks and measurements (tracks_ × measurements_), found through a grid.
+  SparseCosts gate() const;
+  /// The Mahalanobis² of @p z's innovation for @p t, when within the gates.
+  std::optional<double> gateCost(const Track& t, const Measurement& z) const;
   /// Kalman update of @p t with @p m and the box's bookkeeping; true when step long box turned the box.
   bool correct(Track& t, const Measurement& m, double stamp) const;
   void decideMotion(Track& t, double stamp) const;

@@ -6,6 +6,8 @@
  */
 #pragma once
 
+#include <array>
+#include <chrono>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -30,6 +32,9 @@
 
 namespace map_aided_fusion {
 
+/// How many core::StartedVerdict values there are.
+constexpr std::size_t kStartedVerdicts = static_cast<std::size_t>(core::StartedVerdict::kNoTransform) + 1;
+
 /// Counters since start, reported on /diagnostics.
 struct FusionCounters
 {
@@ -49,6 +54,8 @@ struct FusionCounters
   std::size_t sigma_clamped = 0;        ///< covariances whose σ exceeded core::kMaxPositionSigma (clamped)
   std::size_t prior_softenings = 0;     ///< times the prior was softened anew (new prior or σ changed)
   std::size_t shifts_ahead = 0;         ///< window shifts made on `scan_grid/started`, before their scan (shift_ahead)
+  /// `scan_grid/started` headers refused, by core::StartedVerdict (kShift and kNoScanYet stay 0).
+  std::array<std::size_t, kStartedVerdicts> started_refused{};
 };
 
 /// The fusion node's own parameters besides the MapGrid's (config/fusion.yaml).
@@ -119,8 +126,25 @@ public:
 private:
   void onScanIn(const EvidentialGrid::ConstPtr& msg);
   void onScan(const EvidentialGrid::ConstPtr& msg);
+  /// When a scan's callback reached each stage (steady clock), and the cloud's age at its start (ms).
+  struct ScanTimes
+  {
+    std::chrono::steady_clock::time_point start, update, tracking, outputs;
+    double cloud_age_ms = 0.0;
+    core::StageTimes stages;  ///< the MapGrid update's own stages
+  };
+  /// Parts of onScan(): the ScanGrid message into @p scan (false: rejected, counted); the vehicle pose at its stamp
+  /// (none: dropped, counted); the stamp's verdict under mutex_ (false: dropped, counted; a genuine jump resets and
+  /// admits); a warning on a pose jump; the latencies of the scan fused.
+  bool convertScan(const EvidentialGrid& msg, core::ScanMassGrid& scan);
+  std::optional<core::Pose2> scanPose(const EvidentialGrid& msg);
+  bool admitStamp(const ros::Time& stamp);
+  void warnPoseJump(const core::Pose2& pose, double stamp);
+  void recordLatency(const ScanTimes& times, const ros::Time& stamp);
   /// shift_ahead: a ScanGrid stamped @p header is being built; the window moves now as its update would move it,
-  /// when the pose at that stamp is already in tf and the scan would be fused (a newer stamp, no pending parameters).
+  /// when the header describes a scan that will be fused (core::checkStarted(): the frame of the fused scans, a
+  /// newer stamp within the clock's tolerances, a pose in tf reachable at max_plausible_speed, no pending
+  /// parameters); any other header is refused and counted by cause.
   void onScanStarted(const std_msgs::Header::ConstPtr& header);
   /// How far a stamp is ahead of ROS time, and whether a scan so stamped is dropped for it (further than
   /// future_tolerance, or than time_jump_threshold soon after a backward jump). Under mutex_.
@@ -153,6 +177,12 @@ private:
   void track(const std_msgs::Header& header, double stamp, const core::Pose2& pose, const core::ObstaclePoints& returns,
              const core::ScanMassGrid& scan, const core::PriorWindow* prior);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// Parts of diagnose(), under mutex_, at steady time @p now: the scans' counters and the last scan's stage times;
+  /// the latency quantiles over the window; the prior, pose covariance and shifts ahead; the tracker.
+  void diagnoseCounters(diagnostic_updater::DiagnosticStatusWrapper& status, double now);
+  void diagnoseLatency(diagnostic_updater::DiagnosticStatusWrapper& status, double now);
+  void diagnosePrior(diagnostic_updater::DiagnosticStatusWrapper& status, double now);
+  void diagnoseTracker(diagnostic_updater::DiagnosticStatusWrapper& status, double now);
 
   ros::NodeHandle nh_, pnh_;
   FusionNodeParams node_params_;
@@ -169,6 +199,9 @@ private:
   std::optional<core::Pose2> last_pose_;
   double last_jump_wall_ = -1e9;  ///< steady time of the last reset for a time jump
   std::string last_scan_frame_;
+  std::string fused_frame_;  ///< frame of the last fused scan: a `started` header must be in it
+  std::optional<double> shifted_stamp_;  ///< stamp of the last `started` header honoured since the last fused scan
+  core::SlidingCounter started_refused_window_;
   std::string dropped_frame_;  ///< frame of the last scan dropped for want of its transform
   FusionCounters counters_;
   core::SlidingCounter fused_window_, lost_window_;
@@ -177,6 +210,7 @@ private:
   std::vector<std::uint8_t> background_;   ///< per obstacle return of the scan: on static background
   std::uint64_t tracker_resets_seen_ = 0;  ///< the tracker's resets already counted in the window
   core::SlidingCounter tracker_resets_window_;
+  core::SlidingCounter tracker_bounded_window_;  ///< scans in which the tracker dropped measurements or tracks
   std::size_t last_tracks_ = 0, last_moving_tracks_ = 0;
   double start_wall_ = 0.0;
   double last_fused_wall_ = 0.0;
@@ -186,8 +220,9 @@ private:
   /// the callback starts (ScanGrid build, hand-over, tf wait) and when its decision is out, and each stage.
   struct LatencyWindows
   {
-    core::SlidingSamples cloud_to_callback, cloud_to_decision, conversion, shift, project_scan, prior_window, fusion,
-        tracking, outputs;
+    /// The cloud's age: latencies, and stamps ahead of a lagging clock counted apart (never a negative latency).
+    core::LatencyWindow cloud_to_callback, cloud_to_decision;
+    core::SlidingSamples conversion, shift, project_scan, prior_window, fusion, tracking, outputs;
     core::SlidingSamples shift_ahead;  ///< the shifts made on `scan_grid/started`, before the scan's callback
     core::SlidingSamples skipped;  ///< share of the window's cells the step skipped (MapGridParams::skip_unchanged)
     core::SlidingSamples changing;  ///< share the step computed under a vacuous scan (neither skipped nor observed)

@@ -12,7 +12,6 @@
  */
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -22,6 +21,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/buffer.h>
@@ -138,7 +138,8 @@ private:
   core::SlidingCounter received_window_, published_window_, rejected_window_, deskew_skipped_window_,
       ground_fallback_window_;
   /// ms over the window: building a cloud's grid, and the cloud's age when its grid is published.
-  core::SlidingSamples processing_samples_, cloud_to_published_;
+  core::SlidingSamples processing_samples_;
+  core::LatencyWindow cloud_to_published_;  ///< latencies; clouds stamped ahead of the clock counted apart
   double window_processing_sum_ = 0.0;
   double window_processing_max_ = 0.0;
   std::size_t window_processed_ = 0;
@@ -154,10 +155,9 @@ private:
   core::InputGapCounter gaps_;
   core::SlidingCounter lost_window_, overrun_window_, stream_gap_window_;
   std::size_t clouds_lost_ = 0, overruns_ = 0;
-  std::size_t stream_gaps_ = 0;           ///< clouds missing from the stream while the node was idle (paused, skipped)
-  /// Steady time the last callback of the cloud path (the check in onCloud or the build) returned: a stamp gap
-  /// seen while the node was busy less than 1.5 periods before is a loss in the input queue.
-  std::atomic<double> last_busy_end_{ 0.0 };
+  /// Clouds missing from the stream (a gap in its stamps): the source, the network, or the intake's own queue
+  /// should it ever fall kIntakeQueue clouds behind. Clouds this node discards are clouds_lost_, counted one by one.
+  std::size_t stream_gaps_ = 0;
   /// Clouds handed to the tf filter and not yet built, dropped or cleared: the backlog input_queue_size bounds.
   std::size_t pending_builds_ = 0;
   std::size_t reconfigure_refused_ = 0;
@@ -169,6 +169,11 @@ private:
   std::unique_ptr<dynamic_reconfigure::Server<ScanGridConfig>> reconfigure_;
   std::unique_ptr<StartupFailure> failure_;  ///< ERROR diagnostics when the parameters were refused
   std::unique_ptr<diagnostic_updater::Updater> updater_;
+  /// The intake: `points` is received on its own thread (intake_queue_), whose callback (onCloud) only checks a
+  /// cloud and hands it to the tf filter, so that it never waits behind a build and no cloud is lost unseen in
+  /// roscpp's queue; the builds run on the node's callback queue, where takePendingBuild() bounds and counts them.
+  ros::CallbackQueue intake_queue_;
+  std::unique_ptr<ros::AsyncSpinner> intake_spinner_;
   ros::Subscriber cloud_sub_;
   ros::Publisher grid_pub_;
   ros::Publisher occupancy_pub_;
