@@ -2,8 +2,10 @@
  * @file tracker.hpp
  * @brief Tracked objects (ROS-free): per scan, measurements from clusters of the scan's obstacle returns; tracks with
  *        a constant-velocity Kalman filter, associated to the measurements by a gated global assignment
- *        (core/assignment.hpp), with a lifecycle (tentative → confirmed → coasting → deleted) and a motion decision
- *        from the velocity and its covariance (moving, stopped or not yet known).
+ *        (core/assignment.hpp; candidates found through a grid, each gated component solved apart), with a lifecycle
+ *        (tentative → confirmed → coasting → deleted) and a motion decision from the velocity and its covariance
+ *        (moving, stopped or not yet known). A scan's cost is bounded: at most max_measurements measurements and
+ *        max_tracks tracks, the nearest to the sensor first.
  *
  * Not in the paper: it gives each object an id and a velocity, and the motion evidence the grid's classes lack
  * (doc/evaluation.md scores it with CLEAR-MOT). The `paper` profile does not use it.
