@@ -206,6 +206,9 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
                     return masses.zeta(i) > p.background_zeta || (building && betp_c[i] > p.background_building);
                   },
                   background);
+  // After a start or a reset ζ is 0 everywhere: a facade is no background until the counter has had its scans.
+  tracker.setBackgroundKnown(grid.scans() >=
+                             backgroundWarmupScans(p.background_zeta, grid.params().fusion.counter.delta_inc));
   tracker.update(stamp, pose, returns, &background, scan);
   std::vector<CellMotion> cells = trackEvidence(tracker, g);
   if (!prior && p.evidence_without_map)

@@ -638,6 +638,13 @@ double Track::speedSigma() const
 
 Tracker::Tracker(const TrackerParams& params) : params_(params) { params_.validate(); }
 
+std::size_t backgroundWarmupScans(double background_zeta, double delta_inc)
+{
+  if (!(delta_inc > 0.0) || !(background_zeta < 1.0)) return 0;
+  if (background_zeta < 0.0) return 1;
+  return static_cast<std::size_t>(std::floor(background_zeta / delta_inc)) + 1;
+}
+
 void Tracker::reset()
 {
   ++counts_.resets;
@@ -736,6 +743,7 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   }
   ++t.hits;
   ++t.consecutive_hits;
+  if (background_known_) t.background_unchecked = false;
   t.last_hit = stamp;
   if (t.state == TrackState::kCoasting || (t.state == TrackState::kTentative && t.consecutive_hits >= params_.confirm_hits))
     t.state = TrackState::kConfirmed;
@@ -1216,6 +1224,7 @@ Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
   t.hits = t.consecutive_hits = 1;
   t.first_stamp = t.last_hit = stamp;
   t.measurement = measurement;
+  t.background_unchecked = !background_known_;
   if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
   if (free_now_) seeFreeSpace(t, stamp);
   decideMotion(t, stamp);

@@ -727,11 +727,12 @@ void FusionWorker::track(const std_msgs::Header& header, double stamp, const cor
     tracker_resets_window_.add(core::steadySeconds());
     ROS_WARN("fusion: every track dropped (time went back or the vehicle pose jumped)");
   }
-  last_tracks_ = last_moving_tracks_ = 0;
+  last_tracks_ = last_moving_tracks_ = last_held_back_tracks_ = 0;
   for (const core::Track& t : tracker_->tracks())
   {
-    last_tracks_ += t.reported();
-    last_moving_tracks_ += t.reported() && t.motion == core::TrackMotion::kMoving;
+    last_tracks_ += t.published();
+    last_moving_tracks_ += t.published() && t.motion == core::TrackMotion::kMoving;
+    last_held_back_tracks_ += t.reported() && !t.published();
   }
   if (tracks_pub_.getNumSubscribers() + tracks_markers_pub_.getNumSubscribers() == 0) return;
   auto tracks = boost::make_shared<TrackedObjectArray>();
@@ -890,6 +891,8 @@ void FusionWorker::diagnoseTracker(diagnostic_updater::DiagnosticStatusWrapper& 
     const core::TrackerCounts& c = tracker_->counts();
     status.add("tracks (last scan)", last_tracks_);
     status.add("moving tracks (last scan)", last_moving_tracks_);
+    status.add("tracks held back (last scan; born before the counter could mark static background)",
+               last_held_back_tracks_);
     status.add("tracker resets in window", tracker_resets_window_.count(now));
     status.add("tracker resets", c.resets);
     status.add("tracks deleted (non-finite or too fast)", c.rejected_tracks);

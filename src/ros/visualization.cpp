@@ -142,7 +142,7 @@ void Visualization::tracksToMessage(const std::vector<core::Track>& tracks, cons
   for (std::size_t i = 0; i < tracks.size(); ++i)
   {
     const core::Track& t = tracks[i];
-    if (!t.reported()) continue;
+    if (!t.published()) continue;
     const core::ObjectBox b = boxes.size() == tracks.size() ? boxes[i] : core::ownBox(t);
     TrackedObject o;
     o.id = t.id;

@@ -711,6 +711,76 @@ TEST(MotionSteps, TrackScanLetsAMoverTakeCAndNOnlyWithoutAPrior)
     }
 }
 
+/// Scans of a parked car and a car driving by at 8 m/s, seen from a vehicle standing at the origin, tracked through
+/// trackScan() from a grid that has fused @p empty_scans of an empty street first. Per scan: whether a track at the
+/// parked car is published, whether one is held back (reported, not published), whether the mover's is published.
+struct PublishedScan
+{
+  bool parked_published, parked_held_back, mover_published;
+};
+std::vector<PublishedScan> parkedAndPassing(int empty_scans, int scans)
+{
+  const Profile profile = defaultProfile();
+  core::Run run(profile);
+  Tracker tracker(profile.tracker);
+  std::vector<std::uint8_t> background;
+  const Pose2 origin{ 0.0, 0.0, 0.0 };
+  for (int k = 0; k < empty_scans; ++k)
+  {
+    run.step(World{}, origin);
+    trackScan(tracker, run.grid, kScanPeriod * run.scans, origin, run.builder.obstaclePoints(), background, &run.scan);
+  }
+  std::vector<PublishedScan> out;
+  for (int k = 0; k < scans; ++k)
+  {
+    const double x = 8.0 + 8.0 * kScanPeriod * k;
+    World world;
+    world.boxes.push_back({ 10.0, -4.0, 14.5, -2.2, 1.5 });  // parked
+    world.boxes.push_back({ x, 3.0, x + 4.0, 4.8, 1.5 });    // driving along +x
+    run.step(world, origin);
+    trackScan(tracker, run.grid, kScanPeriod * run.scans, origin, run.builder.obstaclePoints(), background, &run.scan);
+    PublishedScan p{ false, false, false };
+    for (const Track& t : tracker.tracks())
+    {
+      const bool parked = t.position().y < 0.0;
+      if (parked) p.parked_published |= t.published();
+      if (parked) p.parked_held_back |= t.reported() && !t.published();
+      if (!parked) p.mover_published |= t.published() && t.motion == TrackMotion::kMoving;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+// After a start the counter ζ is 0 everywhere: a parked car is a confirmed track of unknown motion until ζ marks it
+// static background (backgroundWarmupScans() scans). Such a track is held back, never published; the passing car is
+// published as soon as it is moving. The same parked car appearing once the grid is past its warm-up (a car seen for
+// the first time mid-drive) is published while its motion is unknown: the rule is about starts only.
+TEST(MotionSteps, AfterAStartOnlyMoversArePublishedUntilTheCounterCanMarkBackground)
+{
+  const Profile profile = defaultProfile();
+  const std::size_t warmup = backgroundWarmupScans(profile.tracker.background_zeta, profile.map_grid.fusion.counter.delta_inc);
+  ASSERT_GT(warmup, 3u);
+  constexpr int kScans = 20;
+  const std::vector<PublishedScan> start = parkedAndPassing(0, kScans);
+  int held_back = 0, mover_first = -1;
+  for (int k = 0; k < kScans; ++k)
+  {
+    EXPECT_FALSE(start[k].parked_published) << "scan " << k;
+    held_back += start[k].parked_held_back;
+    if (mover_first < 0 && start[k].mover_published) mover_first = k;
+  }
+  EXPECT_GT(held_back, 0) << "the parked car was a confirmed track";
+  ASSERT_GE(mover_first, 0);
+  EXPECT_LT(mover_first, static_cast<int>(warmup)) << "the mover does not wait for the warm-up";
+  EXPECT_TRUE(start.back().mover_published);
+
+  const std::vector<PublishedScan> later = parkedAndPassing(static_cast<int>(warmup), kScans);
+  int published = 0;
+  for (const PublishedScan& p : later) published += p.parked_published;
+  EXPECT_GT(published, 0) << "past the warm-up a new unknown-motion track is published";
+}
+
 // priorBetPBuilding() is BetP(C) of the prior's mass function (pignistic() of PriorWindow::cell()), on cells of every
 // kind: building, road, other, a wall outline, a softened edge and Ω.
 TEST(MotionSteps, PriorBetPBuildingIsThePignisticOfThePriorCell)

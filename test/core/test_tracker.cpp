@@ -129,6 +129,67 @@ std::vector<Measurement> lineAwayFromSensor(int n)
 
 }  // namespace
 
+// The counter ζ starts at 0 and grows by delta_inc per consistent occupied scan: it first exceeds background_zeta at
+// scan ⌊background_zeta / delta_inc⌋ + 1 (values exact in binary here), never when delta_inc is 0 or the threshold 1.
+TEST(Tracker, BackgroundWarmupIsTheFirstScanTheCounterPassesTheThreshold)
+{
+  for (const double delta : { 0.25, 0.125, 0.0625 })
+    for (const double threshold : { 0.0, 0.25, 0.375, 0.5, 0.75 })
+    {
+      double zeta = 0.0;
+      std::size_t k = 0;
+      while (!(zeta > threshold))
+      {
+        zeta = std::min(1.0, zeta + delta);
+        ++k;
+      }
+      EXPECT_EQ(backgroundWarmupScans(threshold, delta), k) << "delta_inc " << delta << ", background_zeta " << threshold;
+    }
+  EXPECT_EQ(backgroundWarmupScans(0.4, 0.0), 0u) << "a counter that never grows: nothing to wait for";
+  EXPECT_EQ(backgroundWarmupScans(1.0, 0.05), 0u) << "ζ never exceeds 1: background by ζ is off";
+  EXPECT_EQ(backgroundWarmupScans(std::nan(""), 0.05), 0u);
+}
+
+// Tracks born while background is not yet known are confirmed (reported) as usual but published only once moving, or
+// once associated after background became known; what stops being seen before that is never published.
+TEST(Tracker, TracksBornBeforeBackgroundIsKnownArePublishedOnlyWhenMovingOrSeenAfter)
+{
+  Tracker tracker;
+  tracker.setBackgroundKnown(false);
+  std::uint32_t still = 0, mover = 0, gone = 0;
+  for (int k = 0; k < 8; ++k)
+  {
+    const double t = 0.1 * k;
+    tracker.update(t, { at(5.0, -2.0), at(10.0 + 8.0 * t, 4.0), at(-6.0, 8.0) });
+    ASSERT_EQ(tracker.tracks().size(), 3u) << "scan " << k;
+    for (const Track& tr : tracker.tracks())
+    {
+      EXPECT_TRUE(tr.background_unchecked);
+      EXPECT_EQ(tr.reported(), k >= 2) << "confirmed as usual, scan " << k;
+      EXPECT_EQ(tr.published(), tr.reported() && tr.motion == TrackMotion::kMoving) << "scan " << k;
+    }
+    if (k == 0)
+    {
+      still = tracker.tracks()[0].id;
+      mover = tracker.tracks()[1].id;
+      gone = tracker.tracks()[2].id;
+    }
+  }
+  ASSERT_NE(byId(tracker, mover), nullptr);
+  EXPECT_TRUE(byId(tracker, mover)->published()) << "the mover is out before background is known";
+  EXPECT_FALSE(byId(tracker, still)->published());
+  tracker.setBackgroundKnown(true);
+  tracker.update(0.8, { at(5.0, -2.0), at(10.0 + 8.0 * 0.8, 4.0) });
+  ASSERT_NE(byId(tracker, still), nullptr);
+  EXPECT_FALSE(byId(tracker, still)->background_unchecked);
+  EXPECT_TRUE(byId(tracker, still)->published()) << "associated while background is known: not background";
+  ASSERT_NE(byId(tracker, gone), nullptr);
+  EXPECT_EQ(byId(tracker, gone)->state, TrackState::kCoasting);
+  EXPECT_FALSE(byId(tracker, gone)->published()) << "not seen since background is known";
+  tracker.update(0.9, { at(5.0, -2.0), at(10.0 + 8.0 * 0.9, 4.0), at(20.0, -9.0) });
+  EXPECT_FALSE(tracker.tracks().back().background_unchecked) << "born while background is known";
+}
+
 TEST(Tracker, MeasurementsOverTheBoundAreTheFarthestDroppedAndCounted)
 {
   TrackerParams p;

@@ -60,7 +60,9 @@ float priorBetPBuilding(const PriorWindow& prior, std::size_t i);
  *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan; @p prior is
  *        the prior the grid's update() fused (nullptr: none). Without a prior, with step movers without a map, the
  *        cells of a moving track's returns and a small mover's box cells also take N and C (CellMotion::take_n,
- *        take_c).
+ *        take_c). Until @p grid has fused backgroundWarmupScans() scans since its reset the tracker is told that
+ *        background is not yet known (Tracker::setBackgroundKnown()): the tracks born then are published only once
+ *        moving or associated after it (Track::published()).
  */
 void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose, const ObstaclePoints& returns,
                std::vector<std::uint8_t>& background, const ScanMassGrid* scan = nullptr,

@@ -505,6 +505,10 @@ struct Track
   bool motion_seen = false;
   std::vector<Sighting> sightings;
   SeenBox seen_box;  ///< step hidden centre: the box it reported when last seen
+  /// Born while the MapGrid's counter ζ could not yet mark static background (Tracker::setBackgroundKnown(false): the
+  /// first scans after the grid was started or reset) and not associated since it could: it may be a facade or a
+  /// parked car the background test has not yet had the scans to recognise.
+  bool background_unchecked = false;
 
   Point2 position() const { return Point2{ x(0), x(1) }; }
   Point2 velocity() const { return Point2{ x(2), x(3) }; }
@@ -516,7 +520,22 @@ struct Track
   /// Seconds since the first association.
   double age(double now) const { return now - first_stamp; }
   bool reported() const { return state != TrackState::kTentative; }
+  /// What the nodelet publishes: reported, and either moving or checked against static background
+  /// (background_unchecked false). After a start or a reset the grid's counter needs backgroundWarmupScans() scans
+  /// before it tells static structure from objects; until then only the moving tracks go out.
+  bool published() const
+  {
+    return reported() && (motion == TrackMotion::kMoving || !background_unchecked);
+  }
 };
+
+/**
+ * @brief The scans of consistent occupied evidence after which the counter ζ (0 after a reset, + @p delta_inc per
+ *        scan) exceeds @p background_zeta, i.e. the first scan at which a return can be recognised as static
+ *        background: ⌊background_zeta / delta_inc⌋ + 1. 0 when the counter never gets there (delta_inc ≤ 0 or
+ *        background_zeta ≥ 1): then waiting would tell nothing.
+ */
+std::size_t backgroundWarmupScans(double background_zeta, double delta_inc);
 
 /// What went wrong, counted since the start (diagnostics read differences).
 struct TrackerCounts
@@ -630,6 +649,11 @@ public:
   }
   /// The speed the motion decision takes: relative to the common motion at the track.
   double decisionSpeed(const Track& t) const { return t.speedRelativeTo(commonMotionAt(t.position())); }
+  /// Whether the returns' background flags of the next update() can already mark static background (trackScan():
+  /// the MapGrid has fused at least backgroundWarmupScans() scans since its reset). Tracks born while it cannot are
+  /// Track::background_unchecked until an association while it can. Default true.
+  void setBackgroundKnown(bool known) { background_known_ = known; }
+  bool backgroundKnown() const { return background_known_; }
   /// Drops every track and the free space of earlier scans, forgets the last stamp, and counts a reset
   /// (TrackerCounts::resets; ids keep counting up). Called on a time jump or a pose jump.
   void reset();
@@ -701,6 +725,7 @@ private:
   std::uint32_t next_id_ = 1;
   double last_stamp_ = -1.0;
   Pose2 last_pose_;
+  bool background_known_ = true;
 };
 
 }  // namespace core

@@ -211,7 +211,7 @@ private:
   std::uint64_t tracker_resets_seen_ = 0;  ///< the tracker's resets already counted in the window
   core::SlidingCounter tracker_resets_window_;
   core::SlidingCounter tracker_bounded_window_;  ///< scans in which the tracker dropped measurements or tracks
-  std::size_t last_tracks_ = 0, last_moving_tracks_ = 0;
+  std::size_t last_tracks_ = 0, last_moving_tracks_ = 0, last_held_back_tracks_ = 0;
   double start_wall_ = 0.0;
   double last_fused_wall_ = 0.0;
   core::StageTimes last_times_;

@@ -44,7 +44,8 @@ public:
 
   /**
    * @brief The reported tracks (confirmed and coasting) as messages: id, motion (cell_class 3 stopped, 4 moving,
-   *        5 not yet known), box, velocity and its covariance, age, hits. Tentative tracks are left out.
+   *        5 not yet known), box, velocity and its covariance, age, hits. Tentative tracks are left out, and so are
+   *        the tracks not yet checked against static background (core::Track::published()).
    * @param now  s, the scan's stamp (for the age)
    * @param boxes  what each track reports as its object (core::reportedBoxes(), one per track, in order); empty: each
    *               track's own box (core::ownBox())
