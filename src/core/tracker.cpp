@@ -269,9 +269,8 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
 {
   const double cell = 0.5 * p.cluster_distance;
   // A return this far out (a pose of 10¹⁵ m) has no cell index: skipped, as a non-finite one.
-  const auto clusterable = [&](Point2 q) {
-    return std::abs(q.x) / cell < kMaxCellCoordinate && std::abs(q.y) / cell < kMaxCellCoordinate;
-  };
+  const double reach = kMaxCellCoordinate * cell;
+  const auto clusterable = [&](Point2 q) { return std::abs(q.x) < reach && std::abs(q.y) < reach; };
   // Cells holding returns, each with its points; union-find over 8-connected cells. The cells are indexed in a dense
   // local grid over the returns' bounding box, or a hash map when that box is too large (far outliers).
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
@@ -326,30 +325,35 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     while (parent[a] != a) a = parent[a] = parent[parent[a]];
     return a;
   };
+  // Each pair of touching cells once (the four neighbours ahead); a component's root is its smallest cell.
+  constexpr int kAhead[4][2] = { { 1, 0 }, { -1, 1 }, { 0, 1 }, { 1, 1 } };
   for (std::size_t k = 0; k < coords.size(); ++k)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-      {
-        if (dx == 0 && dy == 0) continue;
-        const int* n = slot(coords[k].first + dx, coords[k].second + dy);
-        if (!n || *n < 0) continue;
-        const int a = root(static_cast<int>(k)), b = root(*n);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-      }
-  // Points per cluster, in point order; clusters numbered by their root cell.
+    for (const auto& d : kAhead)
+    {
+      const int* n = slot(coords[k].first + d[0], coords[k].second + d[1]);
+      if (!n || *n < 0) continue;
+      const int a = root(static_cast<int>(k)), b = root(*n);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  for (std::size_t k = 0; k < coords.size(); ++k) parent[k] = root(static_cast<int>(k));  // flat: parent is the root
+  // Points per cluster, in point order; clusters numbered by the first point of each (counted, then filled).
   std::vector<int> cluster_of_root(coords.size(), -1);
-  std::vector<std::vector<int>> clusters;
+  std::vector<int> cluster_size;
   for (int i = 0; i < static_cast<int>(points.size()); ++i)
   {
     if (cell_of[i] < 0) continue;
-    int& c = cluster_of_root[root(cell_of[i])];
+    int& c = cluster_of_root[parent[cell_of[i]]];
     if (c < 0)
     {
-      c = static_cast<int>(clusters.size());
-      clusters.emplace_back();
+      c = static_cast<int>(cluster_size.size());
+      cluster_size.push_back(0);
     }
-    clusters[c].push_back(i);
+    ++cluster_size[c];
   }
+  std::vector<std::vector<int>> clusters(cluster_size.size());
+  for (std::size_t c = 0; c < clusters.size(); ++c) clusters[c].reserve(static_cast<std::size_t>(cluster_size[c]));
+  for (int i = 0; i < static_cast<int>(points.size()); ++i)
+    if (cell_of[i] >= 0) clusters[cluster_of_root[parent[cell_of[i]]]].push_back(i);
   std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
   std::vector<int> split;  // step background split: the returns off background of the clusters too large
   auto tooLarge = [&](const std::vector<int>& idx) {
@@ -370,7 +374,7 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     }
     return std::hypot(hx - lx, hy - ly) > smallest_limit;
   };
-  for (const std::vector<int>& idx : clusters)
+  for (std::vector<int>& idx : clusters)
   {
     if (static_cast<int>(idx.size()) < p.min_cluster_points) continue;
     bool on_background_mostly = false;
@@ -435,12 +439,13 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     m.hi_v = hi_v;
     m.yaw = std::atan2(major.y(), major.x());
     m.points = static_cast<int>(idx.size());
-    m.returns = idx;
     const double su = clusterSigma(p, m.length), sv = clusterSigma(p, m.width);
     Eigen::Matrix2d axes;
     axes << major, minor;
     m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
-    ordered.emplace_back(*std::min_element(idx.begin(), idx.end()), m);
+    const int first = idx.front();  // in point order: the smallest
+    m.returns = std::move(idx);
+    ordered.emplace_back(first, std::move(m));
   }
   if (split.size() >= static_cast<std::size_t>(p.min_cluster_points))
   {
@@ -455,10 +460,12 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
       ordered.emplace_back(first, std::move(m));
     }
   }
-  std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::size_t> order(ordered.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ordered[a].first < ordered[b].first; });
   std::vector<Measurement> out;
   out.reserve(ordered.size());
-  for (auto& [k, m] : ordered) out.push_back(m);
+  for (const std::size_t k : order) out.push_back(std::move(ordered[k].second));
   return out;
 }
 
@@ -1283,27 +1290,34 @@ SparseCosts Tracker::gate() const
   const double cell = std::max(params_.max_gate_distance, kMinGateCell);
   std::vector<std::pair<std::uint64_t, int>> index;
   std::vector<int> wide;  // measurements met by every track
+  std::vector<double> reach(measurements_.size());  // max_gate_distance + √2 c + slack, per measurement
   for (int m = 0; m < cost.cols; ++m)
   {
     const Measurement& z = measurements_[m];
     const double c = std::hypot(std::max(std::abs(z.lo_u), std::abs(z.hi_u)), std::max(std::abs(z.lo_v), std::abs(z.hi_v)));
-    const CellSpan span = cellSpan(z.centroid, params_.max_gate_distance + std::sqrt(2.0) * c + kGateSlack, cell);
+    reach[m] = params_.max_gate_distance + std::sqrt(2.0) * c + kGateSlack;
+    const CellSpan span = cellSpan(z.centroid, reach[m], cell);
     if (span.wide) wide.push_back(m);
     for (std::int64_t cx = span.x0; cx <= span.x1 && !span.wide; ++cx)
       for (std::int64_t cy = span.y0; cy <= span.y1; ++cy) index.emplace_back(gateKey(cx, cy), m);
   }
   std::sort(index.begin(), index.end());
   std::vector<int> seen_by(measurements_.size(), -1);
+  double track_reach = 0.0;  // ½ d + slack of the track considered
   const auto consider = [&](int t, int m) {
     if (seen_by[m] == t) return;
     seen_by[m] = t;
+    // The grid's cells are coarser than the discs: a pair whose discs do not meet is beyond the gate already.
+    const Point2 p = tracks_[t].position(), q = measurements_[m].centroid;
+    const double dx = p.x - q.x, dy = p.y - q.y, r = reach[m] + track_reach;
+    if (dx * dx + dy * dy > r * r) return;
     if (const std::optional<double> d2 = gateCost(tracks_[t], measurements_[m])) cost.pairs.push_back(GatedPair{ t, m, *d2 });
   };
   for (int t = 0; t < cost.rows; ++t)
   {
     const Track& track = tracks_[t];
-    const CellSpan span =
-        cellSpan(track.position(), 0.5 * std::hypot(track.extent_length, track.extent_width) + kGateSlack, cell);
+    track_reach = 0.5 * std::hypot(track.extent_length, track.extent_width) + kGateSlack;
+    const CellSpan span = cellSpan(track.position(), track_reach, cell);
     for (const int m : wide) consider(t, m);
     if (span.wide)
     {
