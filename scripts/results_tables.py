@@ -218,8 +218,9 @@ def mover_tracks_table(variants, profile="default"):
     return "\n".join(lines) + "\n"
 
 
-def held_out_table(held):
-    """Each held-out drive, then the drives pooled, for each profile, in the simulator's columns."""
+def held_out_table(held, sealed=None):
+    """Each held-out drive, then the drives pooled, for each profile, in the simulator's columns; then the sealed
+    drives pooled (their scores exist only pooled)."""
     presets = {d["name"]: d["preset"] for d in held["drives"]}
     lines = ["| drive | profile | " + " | ".join(c for c, _ in SIM_COLUMNS) + " |",
              "| --- | --- | " + " | ".join("---:" for _ in SIM_COLUMNS) + " |"]
@@ -227,12 +228,18 @@ def held_out_table(held):
         rows = [(f"`{n}` ({presets.get(n, '?')})", m) for n, m in v["drives"].items()]
         rows.append((f"pooled ({len(v['drives'])} drives)", v["pooled"]))
         lines += [f"| {name} | {profile} | " + " | ".join(f(m) for _, f in SIM_COLUMNS) + " |" for name, m in rows]
+    if sealed:
+        for profile, v in sealed["variants"].items():
+            name = f"**sealed**, pooled ({len(sealed['drives'])} drives)"
+            lines.append(f"| {name} | {profile} | " + " | ".join(f(v["pooled"]) for _, f in SIM_COLUMNS) + " |")
     return ("The held-out split of `learning/drives.yaml` (never used for learning), written by `learning/held_out`: "
             "each drive, then the drives pooled (confusion matrices, movers and CLEAR-MOT counts summed over the "
-            "drives, not averaged; `learning/maf_learning/objective.py`).\n\n" + "\n".join(lines) + "\n")
+            "drives, not averaged; `learning/maf_learning/objective.py`). Some held-out drives were looked at while "
+            "steps were designed; the sealed split (fresh seeds, `learning/held_out --split sealed`) was frozen "
+            "before the tracker's redesign and is written pooled only.\n\n" + "\n".join(lines) + "\n")
 
 
-def summary(sim, real_pooled, tracking, held=None):
+def summary(sim, real_pooled, tracking, held=None, sealed=None):
     """One table: each dataset's key figures for the default and the paper profiles."""
     lines = ["| data | figure | default | paper |", "| --- | --- | ---: | ---: |"]
 
@@ -248,6 +255,10 @@ def summary(sim, real_pooled, tracking, held=None):
         pooled = {profile: v["pooled"] for profile, v in held["variants"].items()}
         for title in ("V precision", "V recall", "movers V ≤ 1 s", "MOTA", "velocity RMSE (m/s)"):
             add("held-out drives, pooled", pooled, title, cols[title])
+    if sealed:
+        pooled = {profile: v["pooled"] for profile, v in sealed["variants"].items()}
+        for title in ("V precision", "V recall", "movers V ≤ 1 s", "MOTA", "velocity RMSE (m/s)"):
+            add("sealed drives, pooled", pooled, title, cols[title])
     if real_pooled:
         cols = dict(REAL_COLUMNS)
         data = f"real sequences, pooled ({next(iter(real_pooled.values()))['sequences']})"
@@ -276,6 +287,7 @@ def main():
             json.dump({"sequences": [n for n in REAL_POOLED if n in real], "variants": real_pooled}, f, indent=1)
     tracking = load(os.path.join(a.out, "kitti_tracking", "metrics.json"))
     held = read_json(os.path.join(a.out, "held_out", "metrics.json"))  # learning/held_out's
+    sealed = read_json(os.path.join(a.out, "sealed", "metrics.json"))  # learning/held_out --split sealed
     if sim is None:
         sys.exit(f"results_tables.py: {a.out}/metrics.json is missing (run scripts/demo)")
 
@@ -285,10 +297,10 @@ def main():
              "replaying the bag; `default_without_<step>` is the default with one added step off (doc/steps.md), "
              "`dempster`, `yager`, `single_rate`, `no_counter` are ablations of the paper. "
              "doc/evaluation.md defines every figure.\n\n",
-             "## Summary\n\n", summary(sim, real_pooled, tracking, held),
+             "## Summary\n\n", summary(sim, real_pooled, tracking, held, sealed),
              f"\n## {SIMULATOR}\n\n", table(sim, SIM_COLUMNS), mover_tracks_table(sim)]
     if held:
-        parts += [f"\n## {HELD_OUT}\n\n", held_out_table(held)]
+        parts += [f"\n## {HELD_OUT}\n\n", held_out_table(held, sealed)]
     if real:
         parts += [f"\n## {REAL}\n\n",
                   "Scored per labelled sweep (doc/evaluation.md, \"Labelled real sweeps\"); `live_default` is the "
@@ -319,15 +331,17 @@ def main():
     with open(os.path.join(a.out, "results.md"), "w") as f:
         f.write(text)
     with open(os.path.join(a.out, "results_summary.md"), "w") as f:
-        f.write(summary(sim, real_pooled, tracking, held))
+        f.write(summary(sim, real_pooled, tracking, held, sealed))
     print(f"wrote {a.out}/results.md")
 
     if a.doc and a.readme:
         missing = [title for name, title in REAL_SEQUENCES if name not in real]
-        missing += [name for name, v in (("KITTI tracking", tracking), ("held-out drives", held)) if v is None]
+        missing += [name for name, v in (("KITTI tracking", tracking), ("held-out drives", held),
+                                         ("sealed drives", sealed)) if v is None]
         if missing:
             print(f"results_tables.py: {', '.join(missing)} not evaluated (the real ones need ../shared/data, the "
-                  "held-out drives learning/held_out): doc/results.md and the README are left as they are")
+                  "held-out drives learning/held_out, the sealed ones --split sealed): doc/results.md and the README "
+                  "are left as they are")
             return
         with open(os.path.join(a.doc, "results.md"), "w") as f:
             f.write(text)
@@ -336,7 +350,7 @@ def main():
         i, j = readme.find(BEGIN), readme.find(END)
         if i < 0 or j < i:
             sys.exit(f"results_tables.py: {a.readme} has no results markers")
-        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, real_pooled, tracking, held) + readme[j:]
+        readme = readme[:i + len(BEGIN)] + "\n" + summary(sim, real_pooled, tracking, held, sealed) + readme[j:]
         with open(a.readme, "w") as f:
             f.write(readme)
         print(f"wrote {a.doc}/results.md and the README's results table")

@@ -48,7 +48,10 @@ TEMPLATE_KEYS = {
     "traffic": list, "traffic_speed": list, "parked": list, "leaving": list, "pedestrians": list, "cyclists": list,
     "furniture": list, "lidar_presets": dict, "pose_error_probability": float, "map_error_probability": float,
 }
-DRIVE_SET_KEYS = {"duration", "training", "held_out"}
+DRIVE_SET_KEYS = {"duration", "training", "held_out", "sealed"}
+# The splits of a drive set: training (a study sees these), held_out (scored per drive and pooled), sealed (fresh
+# drives frozen before a redesign: scored pooled only, their per-drive results never written).
+SPLITS = ("training", "held_out", "sealed")
 DRIVE_KEYS = {"template", "seed", "preset", "duration"}
 PRESETS = ("ibeo4", "vlp32", "hdl64")
 
@@ -89,7 +92,8 @@ def load_template(name_or_path):
 
 
 def load_drive_set(path):
-    """{'duration': s, 'training': [drive], 'held_out': [drive]}, each drive {'template', 'seed', ...}."""
+    """{'duration': s, 'training': [drive], 'held_out': [drive], 'sealed': [drive]}, each drive {'template', 'seed',
+    ...}; the splits must not share a drive."""
     with open(path) as f:
         d = yaml.safe_load(f) or {}
     if not isinstance(d, dict):
@@ -102,7 +106,7 @@ def load_drive_set(path):
         raise DriveError(f"drive set {path}: duration {duration} s is outside [1, 600]")
     out = {"duration": duration}
     seen = {}
-    for split in ("training", "held_out"):
+    for split in SPLITS:
         drives = d.get(split, []) or []
         if not isinstance(drives, list):
             raise DriveError(f"drive set {path}: '{split}' must be a list")

@@ -35,18 +35,24 @@ def as_metrics(pooled):
     return out
 
 
+SPLITS = ("held_out", "sealed")  # the drive set's splits this scores; sealed: pooled only
+
+
 def score(drive_set, work, config, profiles=PROFILES, jobs=1, simulate=None, evaluate=None, timeout=600.0,
-          log=print):
-    """Simulates (once, cached under work/drives) and evaluates every held-out drive of drive_set with each profile.
-    Returns {"drive_set", "drives": [{name, template, seed, preset}], "variants": {profile: {"pooled": metrics,
-    "drives": {name: metrics}}}}. Raises runner.EvaluationError naming the drive that failed."""
+          log=print, split="held_out"):
+    """Simulates (once, cached under work/drives) and evaluates every drive of drive_set's split (held_out or
+    sealed) with each profile. Returns {"drive_set", "split", "drives": [{name, template, seed, preset}], "variants":
+    {profile: {"pooled": metrics, "drives": {name: metrics}}}}; for the sealed split "drives" of each variant is
+    left out: those drives are looked at pooled only. Raises runner.EvaluationError naming the drive that failed."""
+    if split not in SPLITS:
+        raise runner.EvaluationError(f"unknown split '{split}' ({', '.join(SPLITS)})")
     simulate = simulate or runner.tool("simulate")
     evaluate = evaluate or runner.tool("evaluate")
     spec = drv.load_drive_set(drive_set)
     road_maps = {}
-    held = [runner.Drive(s, work, road_maps) for s in spec["held_out"]]
+    held = [runner.Drive(s, work, road_maps) for s in spec[split]]
     if not held:
-        raise runner.EvaluationError(f"{drive_set} has no held-out drives")
+        raise runner.EvaluationError(f"{drive_set} has no {split.replace('_', '-')} drives")
     for d in held:
         if d.prepare(simulate, timeout):
             log(f"held_out: simulated {d.name} -> {d.bag}")
@@ -56,8 +62,10 @@ def score(drive_set, work, config, profiles=PROFILES, jobs=1, simulate=None, eva
     variants = {}
     for p in profiles:
         per_drive = {d.name: results[(p, d.name)] for d in held}
-        variants[p] = {"pooled": as_metrics(obj.pool(list(per_drive.values()))), "drives": per_drive}
-    return {"drive_set": os.path.abspath(drive_set),
+        variants[p] = {"pooled": as_metrics(obj.pool(list(per_drive.values())))}
+        if split != "sealed":
+            variants[p]["drives"] = per_drive
+    return {"drive_set": os.path.abspath(drive_set), "split": split,
             "drives": [{"name": d.name, "template": d.template["name"], "seed": d.scenario["seed"],
                         "preset": d.preset} for d in held],
             "variants": variants}

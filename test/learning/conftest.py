@@ -25,7 +25,7 @@ def tools():
     return paths
 
 
-def write_drive_set(path, duration=3.0, training=None, held_out=None):
+def write_drive_set(path, duration=3.0, training=None, held_out=None, sealed=None):
     training = training or [("town", 1, "ibeo4"), ("village", 1, "ibeo4")]
     held_out = held_out or [("town", 101, "ibeo4")]
     with open(path, "w") as f:
@@ -35,6 +35,10 @@ def write_drive_set(path, duration=3.0, training=None, held_out=None):
         f.write("held_out:\n")
         for t, s, p in held_out:
             f.write(f"  - {{template: {t}, seed: {s}, preset: {p}}}\n")
+        if sealed:
+            f.write("sealed:\n")
+            for t, s, p in sealed:
+                f.write(f"  - {{template: {t}, seed: {s}, preset: {p}}}\n")
     return path
 
 

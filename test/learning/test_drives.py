@@ -78,13 +78,18 @@ def test_drives_place_objects_clear_of_buildings_and_routes_on_roads(maps, name)
     assert {"car", "pedestrian", "pole"} <= kinds
 
 
-def test_bundled_drive_set_has_a_disjoint_held_out_split():
+def test_bundled_drive_set_has_disjoint_held_out_and_sealed_splits():
     ds = drives.load_drive_set(os.path.join(ROOT, "learning", "drives.yaml"))
     train = {drives.drive_name(d) for d in ds["training"]}
     held = {drives.drive_name(d) for d in ds["held_out"]}
-    assert len(train) >= 4 and len(held) >= 4
-    assert not train & held
+    sealed = {drives.drive_name(d) for d in ds["sealed"]}
+    assert len(train) >= 4 and len(held) >= 4 and len(sealed) >= 6
+    assert not train & held and not train & sealed and not held & sealed
+    # No seed is shared either: a sealed drive is not a held-out drive with another lidar.
+    seeds = lambda split: {(d["template"], d["seed"]) for d in ds[split]}  # noqa: E731
+    assert not seeds("sealed") & (seeds("training") | seeds("held_out"))
     assert {d["template"] for d in ds["training"]} == {d["template"] for d in ds["held_out"]} == {"town", "village"}
+    assert {d["template"] for d in ds["sealed"]} == {"town", "village"}
 
 
 def test_drive_set_errors_name_the_item(tmp_path):
@@ -99,6 +104,8 @@ def test_drive_set_errors_name_the_item(tmp_path):
     assert "training[0]: unknown key 'sed'" in error("training: [{template: town, sed: 1}]\n")
     assert "unknown preset 'velodyne'" in error("training: [{template: town, seed: 1, preset: velodyne}]\n")
     assert "also a training drive" in error("training: [{template: town, seed: 1}]\nheld_out: [{template: town, seed: 1}]\n")
+    assert "also a held_out drive" in error("held_out: [{template: town, seed: 1}]\nsealed: [{template: town, seed: 1}]\n")
+    assert "'sealed' must be a list" in error("sealed: {template: town, seed: 1}\n")
     assert "duration" in error("duration: 0\n")
 
 

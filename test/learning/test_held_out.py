@@ -50,3 +50,30 @@ def test_a_drive_set_without_held_out_drives_is_a_one_line_error(tmp_path):
     r = run_held_out(["--drives", str(path), "--out", str(tmp_path / "out")])
     assert r.returncode != 0
     assert r.stderr.strip().startswith("held_out:") and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_sealed_drives_are_written_pooled_only(tmp_path, tools):
+    path = write_drive_set(str(tmp_path / "set.yaml"), held_out=[("town", 101, "vlp32")],
+                           sealed=[("village", 102, "hdl64")])
+    held = run_held_out(["--drives", path, "--out", str(tmp_path / "held")])
+    assert held.returncode == 0, held.stderr
+    r = run_held_out(["--drives", path, "--split", "sealed", "--out", str(tmp_path / "sealed"),
+                      "--work", str(tmp_path / "held")])
+    assert r.returncode == 0, r.stderr
+    result = json.load(open(tmp_path / "sealed" / "metrics.json"))
+    assert result["split"] == "sealed"
+    assert [d["name"] for d in result["drives"]] == ["village_102_hdl64"], "the sealed split, not the held-out one"
+    for profile, v in result["variants"].items():
+        assert set(v) == {"pooled"}, f"{profile}: no per-drive scores of a sealed drive"
+        assert v["pooled"]["movers.all.seen"] >= 0
+    named = [line for line in r.stdout.splitlines() if "village_102" in line]
+    assert all(line.startswith("held_out: simulated ") for line in named), "no per-drive score printed either"
+    held_result = json.load(open(tmp_path / "held" / "metrics.json"))
+    assert held_result["split"] == "held_out" and "drives" in held_result["variants"]["default"]
+
+
+def test_a_drive_set_without_sealed_drives_is_a_one_line_error(tmp_path):
+    path = write_drive_set(str(tmp_path / "set.yaml"))
+    r = run_held_out(["--drives", path, "--split", "sealed", "--out", str(tmp_path / "out")])
+    assert r.returncode != 0
+    assert "no sealed drives" in r.stderr and len(r.stderr.strip().splitlines()) == 1
