@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 #include <Eigen/Eigenvalues>
 
 #include "map_aided_fusion/core/assignment.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
+#include "map_aided_fusion/core/tracking/clustering.hpp"
+#include "map_aided_fusion/core/tracking/shape_fit.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -29,7 +30,6 @@ constexpr double kMinGateCell = 0.5;
 constexpr std::int64_t kMaxGateCells = 1024;  // cells one measurement or track covers in the association's grid, at most   // m: the association's grid cells are never smaller (max_gate_distance)
 constexpr double kGateSlack = 0.01;    // m added to the association's search radii (rounding)
 constexpr double kMaxCellCoordinate = 1e15;  // cell indices beyond: out of range (a return skipped, a track clamped)
-constexpr double kMaxDenseCells = 4e6;  // cells of the dense clustering grid (16 MB of indices) before a hash map
 constexpr double kOpenEndsMaxAngle = 20.0 * M_PI / 180.0;  // rad: step open ends probes the cluster's own faces, so it
                                                             // decides along a box axis this near one of them only
 constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks the view (step open ends)
@@ -51,11 +51,6 @@ constexpr double kMinCommonSigma = 0.01;    // m/s: a track's σ(speed) in that 
 constexpr double kCommonTurnSolveTolerance = 1e-9;  // relative residual of its normal equations: above, singular
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
 const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
-
-std::int64_t cellKey(std::int64_t x, std::int64_t y)
-{
-  return static_cast<std::int64_t>((static_cast<std::uint64_t>(x) << 32) ^ (static_cast<std::uint64_t>(y) & 0xffffffffULL));
-}
 
 bool finite(const Eigen::Vector4d& x, const Eigen::Matrix4d& p) { return x.allFinite() && p.allFinite(); }
 
@@ -82,6 +77,45 @@ bool hiddenEnds(const Track& t, const Measurement& m, const TrackerParams& p)
 
 /// Standard deviation of a cluster's centroid along an axis on which it extends @p extent m.
 double clusterSigma(const TrackerParams& p, double extent) { return p.measurement_sigma + p.extent_sigma * extent; }
+
+/// The diagonal of the axis-aligned bounding box of @p points[@p idx] (m).
+double boxDiagonal(const std::vector<Point2>& points, const std::vector<int>& idx)
+{
+  double lx = 1e300, ly = 1e300, hx = -1e300, hy = -1e300;
+  for (int i : idx)
+  {
+    lx = std::min(lx, points[i].x);
+    ly = std::min(ly, points[i].y);
+    hx = std::max(hx, points[i].x);
+    hy = std::max(hy, points[i].y);
+  }
+  return std::hypot(hx - lx, hy - ly);
+}
+
+/// The measurement of a cluster of returns @p idx with the rectangle @p box: its centroid, box and the centroid's
+/// covariance, clusterSigma() of its extent along each of the box's axes.
+Measurement measurementOf(const ClusterBox& box, std::vector<int>&& idx, const TrackerParams& p)
+{
+  const Eigen::Vector2d& major = box.major;
+  const Eigen::Vector2d minor(-major.y(), major.x());
+  Measurement m;
+  m.fitted = box.fitted;
+  m.length = box.hi_u - box.lo_u;
+  m.width = box.hi_v - box.lo_v;
+  m.centroid = Point2{ box.mean.x(), box.mean.y() };
+  m.lo_u = box.lo_u;
+  m.hi_u = box.hi_u;
+  m.lo_v = box.lo_v;
+  m.hi_v = box.hi_v;
+  m.yaw = std::atan2(major.y(), major.x());
+  m.points = static_cast<int>(idx.size());
+  const double su = clusterSigma(p, m.length), sv = clusterSigma(p, m.width);
+  Eigen::Matrix2d axes;
+  axes << major, minor;
+  m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
+  m.returns = std::move(idx);
+  return m;
+}
 
 /// Step open anchor (TrackerParams::open_anchor): the end of @p m on which @p t's box is anchored along the cluster's
 /// major axis (viewAlong()) has free space beyond it.
@@ -116,53 +150,6 @@ Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, cons
     return (su * su + along) * major * major.transpose() + (sv * sv + dw * dw) * minor * minor.transpose();
   }
   return m.covariance + along * major * major.transpose() + dw * dw * minor * minor.transpose();
-}
-
-/// Step box fit (TrackerParams::box_fit): the axis of the rectangle that fits @p idx's returns best by the closeness
-/// criterion, as a unit vector within 90° of @p principal and along the rectangle's longer side.
-Eigen::Vector2d fittedAxis(const std::vector<Point2>& points, const std::vector<int>& idx, const Eigen::Vector2d& mean,
-                           const Eigen::Vector2d& principal, const TrackerParams& p)
-{
-  const std::size_t n = idx.size();
-  std::vector<double> dx(n), dy(n), u(n), v(n);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    dx[i] = points[idx[i]].x - mean.x();
-    dy[i] = points[idx[i]].y - mean.y();
-  }
-  const int tries = static_cast<int>(std::ceil(90.0 / p.box_fit_step - 1e-9));
-  const double closeness = p.box_fit_closeness;
-  double best_score = -1.0, best_angle = 0.0, best_lu = 0.0, best_lv = 0.0;
-  for (int k = 0; k < tries; ++k)
-  {
-    const double angle = k * p.box_fit_step * M_PI / 180.0, c = std::cos(angle), s = std::sin(angle);
-    double lo_u = 1e300, hi_u = -1e300, lo_v = 1e300, hi_v = -1e300;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      u[i] = dx[i] * c + dy[i] * s;
-      v[i] = dy[i] * c - dx[i] * s;
-      lo_u = std::min(lo_u, u[i]);
-      hi_u = std::max(hi_u, u[i]);
-      lo_v = std::min(lo_v, v[i]);
-      hi_v = std::max(hi_v, v[i]);
-    }
-    double score = 0.0;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      const double edge = std::min(std::min(u[i] - lo_u, hi_u - u[i]), std::min(v[i] - lo_v, hi_v - v[i]));
-      score += 1.0 / std::max(edge, closeness);
-    }
-    if (score > best_score)
-    {
-      best_score = score;
-      best_angle = angle;
-      best_lu = hi_u - lo_u;
-      best_lv = hi_v - lo_v;
-    }
-  }
-  const Eigen::Vector2d eu(std::cos(best_angle), std::sin(best_angle)), ev(-eu.y(), eu.x());
-  const Eigen::Vector2d axis = best_lu >= best_lv ? eu : ev;
-  return axis.dot(principal) < 0.0 ? Eigen::Vector2d(-axis) : axis;
 }
 
 }  // namespace
@@ -267,93 +254,7 @@ void TrackerParams::validate() const
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
                                         const std::vector<std::uint8_t>* background)
 {
-  const double cell = 0.5 * p.cluster_distance;
-  // A return this far out (a pose of 10¹⁵ m) has no cell index: skipped, as a non-finite one.
-  const double reach = kMaxCellCoordinate * cell;
-  const auto clusterable = [&](Point2 q) { return std::abs(q.x) < reach && std::abs(q.y) < reach; };
-  // Cells holding returns, each with its points; union-find over 8-connected cells. The cells are indexed in a dense
-  // local grid over the returns' bounding box, or a hash map when that box is too large (far outliers).
-  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-  for (const Point2& q : points)
-    if (clusterable(q))
-    {
-      x0 = std::min(x0, q.x);
-      y0 = std::min(y0, q.y);
-      x1 = std::max(x1, q.x);
-      y1 = std::max(y1, q.y);
-    }
-  if (x0 > x1) return {};
-  // Cells on the world lattice (the same cells from scan to scan), offset by a free border of one cell.
-  const double span_x = (x1 - x0) / cell + 4.0, span_y = (y1 - y0) / cell + 4.0;
-  const bool dense = span_x * span_y <= static_cast<double>(kMaxDenseCells);
-  const auto cx0 = dense ? static_cast<std::int64_t>(std::floor(x0 / cell)) - 1 : 0;
-  const auto cy0 = dense ? static_cast<std::int64_t>(std::floor(y0 / cell)) - 1 : 0;
-  const auto w = dense ? static_cast<std::int64_t>(span_x) : 0;
-  const auto h = dense ? static_cast<std::int64_t>(span_y) : 0;
-  std::vector<int> dense_index;
-  if (dense) dense_index.assign(static_cast<std::size_t>(w * h), -1);
-  std::unordered_map<std::int64_t, int> sparse_index;
-  auto slot = [&](std::int64_t cx, std::int64_t cy) -> int* {
-    if (dense)
-    {
-      cx -= cx0;
-      cy -= cy0;
-      return cx < 0 || cy < 0 || cx >= w || cy >= h ? nullptr : &dense_index[static_cast<std::size_t>(cy * w + cx)];
-    }
-    const auto it = sparse_index.find(cellKey(cx, cy));
-    return it == sparse_index.end() ? nullptr : &it->second;
-  };
-  std::vector<std::pair<std::int64_t, std::int64_t>> coords;
-  std::vector<int> cell_of(points.size(), -1);
-  for (int i = 0; i < static_cast<int>(points.size()); ++i)
-  {
-    const Point2 q = points[i];
-    if (!clusterable(q)) continue;
-    const auto cx = static_cast<std::int64_t>(std::floor(q.x / cell));
-    const auto cy = static_cast<std::int64_t>(std::floor(q.y / cell));
-    int* s = dense ? slot(cx, cy) : &sparse_index.emplace(cellKey(cx, cy), -1).first->second;
-    if (*s < 0)
-    {
-      *s = static_cast<int>(coords.size());
-      coords.emplace_back(cx, cy);
-    }
-    cell_of[i] = *s;
-  }
-  std::vector<int> parent(coords.size());
-  for (std::size_t k = 0; k < parent.size(); ++k) parent[k] = static_cast<int>(k);
-  auto root = [&](int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  // Each pair of touching cells once (the four neighbours ahead); a component's root is its smallest cell.
-  constexpr int kAhead[4][2] = { { 1, 0 }, { -1, 1 }, { 0, 1 }, { 1, 1 } };
-  for (std::size_t k = 0; k < coords.size(); ++k)
-    for (const auto& d : kAhead)
-    {
-      const int* n = slot(coords[k].first + d[0], coords[k].second + d[1]);
-      if (!n || *n < 0) continue;
-      const int a = root(static_cast<int>(k)), b = root(*n);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-  for (std::size_t k = 0; k < coords.size(); ++k) parent[k] = root(static_cast<int>(k));  // flat: parent is the root
-  // Points per cluster, in point order; clusters numbered by the first point of each (counted, then filled).
-  std::vector<int> cluster_of_root(coords.size(), -1);
-  std::vector<int> cluster_size;
-  for (int i = 0; i < static_cast<int>(points.size()); ++i)
-  {
-    if (cell_of[i] < 0) continue;
-    int& c = cluster_of_root[parent[cell_of[i]]];
-    if (c < 0)
-    {
-      c = static_cast<int>(cluster_size.size());
-      cluster_size.push_back(0);
-    }
-    ++cluster_size[c];
-  }
-  std::vector<std::vector<int>> clusters(cluster_size.size());
-  for (std::size_t c = 0; c < clusters.size(); ++c) clusters[c].reserve(static_cast<std::size_t>(cluster_size[c]));
-  for (int i = 0; i < static_cast<int>(points.size()); ++i)
-    if (cell_of[i] >= 0) clusters[cluster_of_root[parent[cell_of[i]]]].push_back(i);
+  std::vector<std::vector<int>> clusters = connectedClusters(points, 0.5 * p.cluster_distance);
   std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
   std::vector<int> split;  // step background split: the returns off background of the clusters too large
   auto tooLarge = [&](const std::vector<int>& idx) {
@@ -363,17 +264,8 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
   };
   // A cluster's extent along any axis is at most its bounding box's diagonal.
   const double smallest_limit = std::min(p.max_object_length, p.max_object_width);
-  auto mayBeTooLarge = [&](const std::vector<int>& idx) {
-    double lx = 1e300, ly = 1e300, hx = -1e300, hy = -1e300;
-    for (int i : idx)
-    {
-      lx = std::min(lx, points[i].x);
-      ly = std::min(ly, points[i].y);
-      hx = std::max(hx, points[i].x);
-      hy = std::max(hy, points[i].y);
-    }
-    return std::hypot(hx - lx, hy - ly) > smallest_limit;
-  };
+  auto mayBeTooLarge = [&](const std::vector<int>& idx) { return boxDiagonal(points, idx) > smallest_limit; };
+  const BoxFitParams fit{ p.box_fit, p.box_fit_min_length, p.max_object_length, p.box_fit_step, p.box_fit_closeness };
   for (std::vector<int>& idx : clusters)
   {
     if (static_cast<int>(idx.size()) < p.min_cluster_points) continue;
@@ -386,66 +278,15 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
       // Step background split needs the extents of such a cluster only when it may be too large.
       if (on_background_mostly && (!p.background_split || !mayBeTooLarge(idx))) continue;
     }
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    for (int i : idx) mean += Eigen::Vector2d(points[i].x, points[i].y);
-    mean /= static_cast<double>(idx.size());
-    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-    for (int i : idx)
-    {
-      const Eigen::Vector2d d = Eigen::Vector2d(points[i].x, points[i].y) - mean;
-      scatter += d * d.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
-    const Eigen::Vector2d principal = eig.eigenvectors().col(1);
-    Eigen::Vector2d major = principal;
-    double lo_u = 1e300, hi_u = -1e300, lo_v = 1e300, hi_v = -1e300;
-    auto extents = [&]() {
-      const Eigen::Vector2d minor(-major.y(), major.x());
-      lo_u = lo_v = 1e300;
-      hi_u = hi_v = -1e300;
-      for (int i : idx)
-      {
-        const Eigen::Vector2d d = Eigen::Vector2d(points[i].x, points[i].y) - mean;
-        lo_u = std::min(lo_u, d.dot(major));
-        hi_u = std::max(hi_u, d.dot(major));
-        lo_v = std::min(lo_v, d.dot(minor));
-        hi_v = std::max(hi_v, d.dot(minor));
-      }
-    };
-    extents();
-    bool fitted = false;
-    // A cluster longer than max_object_length · √2 along its principal axis is too long along any rectangle's.
-    if (p.box_fit && hi_u - lo_u >= p.box_fit_min_length && hi_u - lo_u <= M_SQRT2 * p.max_object_length)
-    {
-      major = fittedAxis(points, idx, mean, principal, p);
-      fitted = std::acos(std::min(1.0, std::abs(major.dot(principal)))) > p.box_fit_step * M_PI / 180.0;
-      extents();
-    }
-    const Eigen::Vector2d minor(-major.y(), major.x());
-    Measurement m;
-    m.fitted = fitted;
-    m.length = hi_u - lo_u;
-    m.width = hi_v - lo_v;
-    if (m.length > p.max_object_length || m.width > p.max_object_width)
+    const ClusterBox box = fitClusterBox(points, idx, fit);
+    if (box.length() > p.max_object_length || box.width() > p.max_object_width)
     {
       tooLarge(idx);
       continue;
     }
     if (on_background_mostly) continue;
-    m.centroid = Point2{ mean.x(), mean.y() };
-    m.lo_u = lo_u;
-    m.hi_u = hi_u;
-    m.lo_v = lo_v;
-    m.hi_v = hi_v;
-    m.yaw = std::atan2(major.y(), major.x());
-    m.points = static_cast<int>(idx.size());
-    const double su = clusterSigma(p, m.length), sv = clusterSigma(p, m.width);
-    Eigen::Matrix2d axes;
-    axes << major, minor;
-    m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
     const int first = idx.front();  // in point order: the smallest
-    m.returns = std::move(idx);
-    ordered.emplace_back(first, std::move(m));
+    ordered.emplace_back(first, measurementOf(box, std::move(idx), p));
   }
   if (split.size() >= static_cast<std::size_t>(p.min_cluster_points))
   {
