@@ -278,40 +278,11 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
 {
   const ros::WallTime start = ros::WallTime::now();
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!takePendingBuild(*cloud)) return;
-  Eigen::Isometry3d pose;
-  try
-  {
-    const std::string& frame = cloud->header.frame_id;
-    const std::string source = tfFrame(frame);
-    pose = toEigen(tf_buffer_->lookupTransform(params_.base_frame, source, cloud->header.stamp).transform);
-    builder_.setSensorPose(pose);
-  }
-  catch (const tf2::TransformException& e)
-  {
-    reject("no_transform", e.what());
-    return;
-  }
-  catch (const core::ParameterError& e)
-  {
-    reject("bad_transform", e.what());
-    return;
-  }
+  if (!takePendingBuild(*cloud) || !setSensorPose(*cloud)) return;
   core::PointCloudView raw, view;
   if (!viewOf(*cloud, raw)) return;
-  const DeskewResult deskew =
-      deskewer_.apply(*cloud, raw, params_.model.deskew, params_.deskew_time_field,
-                      params_.model.deskew_max_sweep_duration, *tf_buffer_, params_.deskew_fixed_frame, view);
-  ++deskew_counts_[deskew.status];
-  last_deskew_ = deskew.status;
-  if (deskew.skipped())
-  {
-    deskew_skipped_window_.add(core::steadySeconds());
-    if (deskew_warned_.insert(deskew.status).second)
-      ROS_WARN("scan_grid: a cloud on %s is not deskewed (%s): %s. Further clouds skipped for this reason are only "
-               "counted (see diagnostics).",
-               cloud_sub_.getTopic().c_str(), deskew.status.c_str(), deskew.detail.c_str());
-  }
+  noteDeskew(deskewer_.apply(*cloud, raw, params_.model.deskew, params_.deskew_time_field,
+                             params_.model.deskew_max_sweep_duration, *tf_buffer_, params_.deskew_fixed_frame, view));
   if (started_pub_.getNumSubscribers() > 0)
   {
     auto started = boost::make_shared<std_msgs::Header>();
@@ -339,6 +310,44 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   std_msgs::Header header;
   header.stamp = cloud->header.stamp;
   header.frame_id = params_.base_frame;
+  publishGrid(header);
+  recordPublished(start, cloud->header.stamp);
+}
+
+bool ScanGridWorker::setSensorPose(const sensor_msgs::PointCloud2& cloud)
+{
+  try
+  {
+    const std::string source = tfFrame(cloud.header.frame_id);
+    builder_.setSensorPose(
+        toEigen(tf_buffer_->lookupTransform(params_.base_frame, source, cloud.header.stamp).transform));
+    return true;
+  }
+  catch (const tf2::TransformException& e)
+  {
+    reject("no_transform", e.what());
+  }
+  catch (const core::ParameterError& e)
+  {
+    reject("bad_transform", e.what());
+  }
+  return false;
+}
+
+void ScanGridWorker::noteDeskew(const DeskewResult& deskew)
+{
+  ++deskew_counts_[deskew.status];
+  last_deskew_ = deskew.status;
+  if (!deskew.skipped()) return;
+  deskew_skipped_window_.add(core::steadySeconds());
+  if (deskew_warned_.insert(deskew.status).second)
+    ROS_WARN("scan_grid: a cloud on %s is not deskewed (%s): %s. Further clouds skipped for this reason are only "
+             "counted (see diagnostics).",
+             cloud_sub_.getTopic().c_str(), deskew.status.c_str(), deskew.detail.c_str());
+}
+
+void ScanGridWorker::publishGrid(const std_msgs::Header& header)
+{
   if (grid_pub_.getNumSubscribers() > 0)
   {
     auto msg = boost::make_shared<EvidentialGrid>();
@@ -353,6 +362,10 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
     GridConversions::scanToOccupancy(grid_, header, *occupancy);
     occupancy_pub_.publish(occupancy);
   }
+}
+
+void ScanGridWorker::recordPublished(const ros::WallTime& start, const ros::Time& stamp)
+{
   ++counters_.clouds_published;
   last_published_wall_ = core::steadySeconds();
   published_window_.add(last_published_wall_);
@@ -361,8 +374,7 @@ void ScanGridWorker::onCloudWithTransform(const sensor_msgs::PointCloud2ConstPtr
   window_processing_max_ = std::max(window_processing_max_, elapsed);
   ++window_processed_;
   processing_samples_.add(last_published_wall_, kMillisecondsPerSecond * elapsed);
-  cloud_to_published_.add(last_published_wall_,
-                          kMillisecondsPerSecond * (ros::Time::now() - cloud->header.stamp).toSec());
+  cloud_to_published_.add(last_published_wall_, kMillisecondsPerSecond * (ros::Time::now() - stamp).toSec());
   if (gaps_.period() > 0.0 && elapsed > gaps_.period())
   {
     ++overruns_;
@@ -428,11 +440,17 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
 {
   std::lock_guard<std::mutex> lock(mutex_);
   const double now = core::steadySeconds();
+  const core::InputFindings found = diagnoseSummary(status, now);
+  diagnoseStream(status, now, found);
+  diagnoseTotals(status, now);
+  window_processed_ = 0;
+  window_processing_sum_ = window_processing_max_ = 0.0;
+}
+
+core::InputFindings ScanGridWorker::diagnoseSummary(diagnostic_updater::DiagnosticStatusWrapper& status, double now)
+{
   const std::size_t published = published_window_.count(now);
   const std::size_t rejected = rejected_window_.count(now);
-  const double mean_ms = window_processed_ > 0 ? kMillisecondsPerSecond * window_processing_sum_ /
-                                                     static_cast<double>(window_processed_) :
-                                                 0.0;
   const bool ever = counters_.clouds_published > 0;
   core::InputFindings found;
   found.blind = blind_.active();
@@ -460,6 +478,16 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     }
   }
   status.summary(static_cast<unsigned char>(h.level), h.message);
+  return found;
+}
+
+void ScanGridWorker::diagnoseStream(diagnostic_updater::DiagnosticStatusWrapper& status, double now,
+                                   const core::InputFindings& found)
+{
+  const std::size_t rejected = rejected_window_.count(now);
+  const double mean_ms = window_processed_ > 0 ? kMillisecondsPerSecond * window_processing_sum_ /
+                                                     static_cast<double>(window_processed_) :
+                                                 0.0;
   status.add("input rate (Hz)", received_window_.rate(now, start_wall_));
   status.add("output rate (Hz)", published_window_.rate(now, start_wall_));
   status.add("clouds rejected in window", rejected);
@@ -492,6 +520,10 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     status.add("largest lead of a stamp over the clock (ms)", "none");
   else
     status.add("largest lead of a stamp over the clock (ms)", lead);
+}
+
+void ScanGridWorker::diagnoseTotals(diagnostic_updater::DiagnosticStatusWrapper& status, double now)
+{
   status.add("clouds received", counters_.clouds_received);
   status.add("clouds published", counters_.clouds_published);
   status.add("clouds rejected", counters_.clouds_rejected);
@@ -527,8 +559,6 @@ void ScanGridWorker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
                                                   std::to_string(last_stats_.obstacle));
   status.add("last cloud: occupied / free cells", std::to_string(last_stats_.occupied_cells) + " / " +
                                                       std::to_string(last_stats_.free_cells));
-  window_processed_ = 0;
-  window_processing_sum_ = window_processing_max_ = 0.0;
 }
 
 }  // namespace map_aided_fusion

@@ -24,6 +24,7 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Header.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
@@ -116,7 +117,21 @@ private:
   bool blindCloud(const core::ScanGridStats& stats);
   /// A view of the cloud's x, y, z; false (rejected and counted) when the cloud cannot be read. Caller holds mutex_.
   bool viewOf(const sensor_msgs::PointCloud2& cloud, core::PointCloudView& view);
+  /// The sensor's pose in base_frame at the cloud's stamp given to the builder; false (rejected and counted) when tf
+  /// has none or it is no rigid transform. Caller holds mutex_.
+  bool setSensorPose(const sensor_msgs::PointCloud2& cloud);
+  /// Counts a cloud's deskew outcome; the first cloud skipped for a reason is WARNed. Caller holds mutex_.
+  void noteDeskew(const DeskewResult& deskew);
+  /// The ScanGrid (with its obstacle returns) and its occupancy view, to their subscribers. Caller holds mutex_.
+  void publishGrid(const std_msgs::Header& header);
+  /// Counts a published cloud: rates, processing time since @p start, latency from @p stamp, overruns.
+  void recordPublished(const ros::WallTime& start, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// diagnose()'s parts, caller holds mutex_: the level and message (returns what the input checks found), the
+  /// stream's rates, losses and latencies in the window, and the totals with the last cloud's figures.
+  core::InputFindings diagnoseSummary(diagnostic_updater::DiagnosticStatusWrapper& status, double now);
+  void diagnoseStream(diagnostic_updater::DiagnosticStatusWrapper& status, double now, const core::InputFindings& found);
+  void diagnoseTotals(diagnostic_updater::DiagnosticStatusWrapper& status, double now);
 
   ros::NodeHandle nh_, pnh_;
   ScanGridNodeParams params_;
