@@ -38,6 +38,16 @@ def write_held_out(path, default_movers):
                                 "paper": {"pooled": sim(0.5, 2), "drives": {"town_101": sim(0.5, 2)}}}}, f)
 
 
+def write_sealed(path, default_movers):
+    """learning/held_out --split sealed's output: pooled scores only."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    pooled = dict(sim(0.625, default_movers), **{"tracks.mota": 0.5, "tracks.velocity_rmse_mps": 1.5})
+    with open(path, "w") as f:
+        json.dump({"split": "sealed", "drives": [{"name": "town_201", "preset": "vlp32"},
+                                                  {"name": "village_201", "preset": "hdl64"}],
+                   "variants": {"default": {"pooled": pooled}, "paper": {"pooled": sim(0.5, 1)}}}, f)
+
+
 REAL = ("kitti_00", "kitti_00_suma", "semantic_kitti_02", "semantic_kitti_06", "semantic_kitti_09",
         "semantic_kitti_10")
 
@@ -79,6 +89,7 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
                   {"default": {"movers.all.detected_within_1s": 3, "movers.all.seen": 5, "tracks.mota": 0.853},
                    "paper": {"movers.all.detected_within_1s": 1, "movers.all.seen": 5}})
     write_held_out(str(out / "held_out" / "metrics.json"), 9)
+    write_sealed(str(out / "sealed" / "metrics.json"), 6)
     (tmp_path / "doc").mkdir()
     readme = fake_readme(str(tmp_path))
     figure = tmp_path / "figure2.png"
@@ -93,11 +104,15 @@ def test_summary_reads_each_profile_from_its_variant(tmp_path):
     assert "| KITTI tracking | MOTA | 0.85 | – |" in text, "the paper has no tracks"
     assert "| held-out drives, pooled | movers V ≤ 1 s | 9/11 | 2/11 |" in text
     assert "| held-out drives, pooled | velocity RMSE (m/s) | 0.25 | – |" in text
+    assert "| sealed drives, pooled | movers V ≤ 1 s | 6/11 | 1/11 |" in text
+    assert "| sealed drives, pooled | MOTA | 0.50 | – |" in text
     assert "old table" not in text and text.endswith("after\n")
     doc = open(tmp_path / "doc" / "results.md").read()
     assert "## Labelled real sequences" in doc and "| default | 0.875 |" in doc
     assert "| SemanticKITTI 10 | default | 2.5 |" in doc
     assert "| `town_101` (vlp32) | default | 0.750 |" in doc and "| pooled (1 drives) | paper | 0.500 |" in doc
+    # The sealed drives pooled only: one row per profile, no drive of theirs named.
+    assert "| **sealed**, pooled (2 drives) | default | 0.625 |" in doc and "town_201" not in doc
     # The movers' velocity errors, the largest share of the squared error first; none for KITTI without tracks.
     assert "| 5 | bus | 10 | 9 | 1.00 | 9 | 2.00 | 1.50 | 0.80 |\n| 9 | car |" in doc
     assert doc.count("Per mover, the tracks of") == 1
@@ -112,9 +127,13 @@ def test_docs_are_left_alone_without_the_held_out_drives(tmp_path):
     (tmp_path / "doc").mkdir()
     readme = fake_readme(str(tmp_path))
     r = run(str(out), "--doc", str(tmp_path / "doc"), "--readme", readme)
-    assert "held-out drives not evaluated" in r.stdout
+    assert "held-out drives, sealed drives not evaluated" in r.stdout
     assert "old table" in open(readme).read()
     assert "Held-out" not in open(out / "results.md").read()
+    # The held-out drives without the sealed ones: still left alone.
+    write_held_out(str(out / "held_out" / "metrics.json"), 9)
+    r = run(str(out), "--doc", str(tmp_path / "doc"), "--readme", readme)
+    assert "sealed drives not evaluated" in r.stdout and "old table" in open(readme).read()
 
 
 def test_docs_are_left_alone_without_the_real_datasets(tmp_path):
