@@ -100,8 +100,8 @@ Measurement measurementOf(const ClusterBox& box, std::vector<int>&& idx, const T
   const Eigen::Vector2d minor(-major.y(), major.x());
   Measurement m;
   m.fitted = box.fitted;
-  m.length = box.hi_u - box.lo_u;
-  m.width = box.hi_v - box.lo_v;
+  m.length = box.length();
+  m.width = box.width();
   m.centroid = Point2{ box.mean.x(), box.mean.y() };
   m.lo_u = box.lo_u;
   m.hi_u = box.hi_u;
@@ -1144,8 +1144,8 @@ SparseCosts Tracker::gate() const
   }
   std::sort(index.begin(), index.end());
   std::vector<int> seen_by(measurements_.size(), -1);
-  double track_reach = 0.0;  // ½ d + slack of the track considered
-  const auto consider = [&](int t, int m) {
+  // track_reach: ½ d + slack of track t.
+  const auto consider = [&](int t, double track_reach, int m) {
     if (seen_by[m] == t) return;
     seen_by[m] = t;
     // The grid's cells are coarser than the discs: a pair whose discs do not meet is beyond the gate already.
@@ -1157,12 +1157,12 @@ SparseCosts Tracker::gate() const
   for (int t = 0; t < cost.rows; ++t)
   {
     const Track& track = tracks_[t];
-    track_reach = 0.5 * std::hypot(track.extent_length, track.extent_width) + kGateSlack;
+    const double track_reach = 0.5 * std::hypot(track.extent_length, track.extent_width) + kGateSlack;
     const CellSpan span = cellSpan(track.position(), track_reach, cell);
-    for (const int m : wide) consider(t, m);
+    for (const int m : wide) consider(t, track_reach, m);
     if (span.wide)
     {
-      for (int m = 0; m < cost.cols; ++m) consider(t, m);
+      for (int m = 0; m < cost.cols; ++m) consider(t, track_reach, m);
       continue;
     }
     for (std::int64_t cx = span.x0; cx <= span.x1; ++cx)
@@ -1171,7 +1171,7 @@ SparseCosts Tracker::gate() const
         const std::uint64_t k = gateKey(cx, cy);
         auto it = std::lower_bound(index.begin(), index.end(), k,
                                    [](const std::pair<std::uint64_t, int>& e, std::uint64_t v) { return e.first < v; });
-        for (; it != index.end() && it->first == k; ++it) consider(t, it->second);
+        for (; it != index.end() && it->first == k; ++it) consider(t, track_reach, it->second);
       }
   }
   return cost;

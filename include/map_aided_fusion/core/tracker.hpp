@@ -653,7 +653,6 @@ public:
   /// the MapGrid has fused at least backgroundWarmupScans() scans since its reset). Tracks born while it cannot are
   /// Track::background_unchecked until an association while it can. Default true.
   void setBackgroundKnown(bool known) { background_known_ = known; }
-  bool backgroundKnown() const { return background_known_; }
   /// Drops every track and the free space of earlier scans, forgets the last stamp, and counts a reset
   /// (TrackerCounts::resets; ids keep counting up). Called on a time jump or a pose jump.
   void reset();
