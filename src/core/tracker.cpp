@@ -9,6 +9,8 @@
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/core/stamp_guard.hpp"
 #include "map_aided_fusion/core/tracking/clustering.hpp"
+#include "map_aided_fusion/core/tracking/association.hpp"
+#include "map_aided_fusion/core/tracking/motion_model.hpp"
 #include "map_aided_fusion/core/tracking/shape_fit.hpp"
 
 namespace map_aided_fusion {
@@ -26,10 +28,8 @@ constexpr int kMaxBound = 1000000;     // max_measurements, max_tracks: beyond a
 constexpr std::size_t kMaxExactComponent = 100;
 constexpr double kSymmetryTolerance = 1e-9;  // relative: a covariance's two off-diagonal terms differ by rounding only
 constexpr double kMaxBox = 1e6;  // m: a measurement's box beyond this (either way) is no object's: not used
-constexpr double kMinGateCell = 0.5;
-constexpr std::int64_t kMaxGateCells = 1024;  // cells one measurement or track covers in the association's grid, at most   // m: the association's grid cells are never smaller (max_gate_distance)
+constexpr double kMinGateCell = 0.5;     // m: the association's grid cells are never smaller (max_gate_distance)
 constexpr double kGateSlack = 0.01;    // m added to the association's search radii (rounding)
-constexpr double kMaxCellCoordinate = 1e15;  // cell indices beyond: out of range (a return skipped, a track clamped)
 constexpr double kOpenEndsMaxAngle = 20.0 * M_PI / 180.0;  // rad: step open ends probes the cluster's own faces, so it
                                                             // decides along a box axis this near one of them only
 constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks the view (step open ends)
@@ -474,15 +474,7 @@ ObjectBox objectBox(const Track& t, const TrackerParams& p, const std::vector<Me
   return b;
 }
 
-double Track::speedSigma() const
-{
-  const Eigen::Matrix2d pv = P.bottomRightCorner<2, 2>();
-  const Eigen::Vector2d v = x.tail<2>();
-  const double s = v.norm();
-  if (s < kTinySpeed) return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(pv).eigenvalues()(1)));
-  const Eigen::Vector2d u = v / s;
-  return std::sqrt(std::max(0.0, u.dot(pv * u)));
-}
+double Track::speedSigma() const { return core::speedSigma(x, P); }
 
 Tracker::Tracker(const TrackerParams& params) : params_(params) { params_.validate(); }
 
@@ -505,19 +497,7 @@ void Tracker::reset()
   common_turn_rate_ = 0.0;
 }
 
-void Tracker::predict(Track& t, double dt) const
-{
-  Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
-  f(0, 2) = f(1, 3) = dt;
-  const double q = params_.acceleration_sigma * params_.acceleration_sigma;
-  const double dt2 = dt * dt, dt3 = dt2 * dt, dt4 = dt3 * dt;
-  Eigen::Matrix4d qm = Eigen::Matrix4d::Zero();
-  qm(0, 0) = qm(1, 1) = 0.25 * dt4 * q;
-  qm(0, 2) = qm(2, 0) = qm(1, 3) = qm(3, 1) = 0.5 * dt3 * q;
-  qm(2, 2) = qm(3, 3) = dt2 * q;
-  t.x = f * t.x;
-  t.P = f * t.P * f.transpose() + qm;
-}
+void Tracker::predict(Track& t, double dt) const { predictConstantVelocity(t.x, t.P, dt, params_.acceleration_sigma); }
 
 namespace {
 
@@ -538,17 +518,8 @@ void turnBox(Track& t, const Measurement& m, double yaw)
 bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
 {
   bool long_box = false;
-  const Eigen::Matrix2d r = measurementCovariance(t, m, params_);
-  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + r;
-  const Eigen::Matrix<double, 4, 2> k = t.P.leftCols<2>() * s.inverse();
   const Point2 ref = referencePoint(t, m);
-  const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
-  t.x += k * y;
-  Eigen::Matrix<double, 2, 4> h = Eigen::Matrix<double, 2, 4>::Zero();
-  h(0, 0) = h(1, 1) = 1.0;
-  const Eigen::Matrix4d ikh = Eigen::Matrix4d::Identity() - k * h;
-  // Joseph form: stays symmetric and positive semi-definite.
-  t.P = ikh * t.P * ikh.transpose() + k * r * k.transpose();
+  correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), measurementCovariance(t, m, params_));
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
@@ -593,14 +564,13 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   ++t.consecutive_hits;
   if (background_known_) t.background_unchecked = false;
   t.last_hit = stamp;
-  if (t.state == TrackState::kCoasting || (t.state == TrackState::kTentative && t.consecutive_hits >= params_.confirm_hits))
-    t.state = TrackState::kConfirmed;
+  t.state = afterHit(t.state, t.consecutive_hits, lifecycleParams());
   return long_box;
 }
 
 bool Tracker::fastEnough(const Track& t, double sigmas) const
 {
-  return decisionSpeed(t) - sigmas * t.speedSigma() > params_.moving_speed;
+  return clearsSpeed(decisionSpeed(t), t.speedSigma(), sigmas, params_.moving_speed);
 }
 
 Tracker::CommonFit Tracker::fitCommonTurn(Point2 start) const
@@ -693,24 +663,18 @@ void Tracker::findCommonMotion(double stamp)
 
 void Tracker::decideMotion(Track& t, double stamp) const
 {
-  if (t.state == TrackState::kTentative)
+  MotionEvidence e;
+  e.tentative = t.state == TrackState::kTentative;
+  if (!e.tentative)
   {
-    t.motion = TrackMotion::kUnknown;
-    return;
+    e.speed = decisionSpeed(t);
+    e.speed_sigma = t.speedSigma();
   }
-  const double s = decisionSpeed(t), sigma = t.speedSigma();
-  if (s + params_.motion_sigmas * sigma < params_.stopped_speed)
-  {
-    if (t.still_since < 0.0) t.still_since = stamp;
-  }
-  else
-    t.still_since = -1.0;
-  if (fastEnough(t, free_now_ ? params_.free_space_motion_sigmas : params_.motion_sigmas) && (!free_now_ || t.motion_seen))
-    t.motion = TrackMotion::kMoving;
-  else if (t.still_since >= 0.0 && stamp - t.still_since >= params_.stopped_time - kMinStep)
-    t.motion = TrackMotion::kStopped;
-  else
-    t.motion = TrackMotion::kUnknown;
+  e.free_space_check = free_now_;
+  e.motion_seen = t.motion_seen;
+  const MotionDecisionParams p{ params_.moving_speed, params_.motion_sigmas, params_.free_space_motion_sigmas,
+                                params_.stopped_speed, params_.stopped_time };
+  t.motion = core::decideMotion(e, stamp, t.still_since, p);
 }
 
 bool Tracker::smallWalker(const Track& t) const
@@ -732,7 +696,7 @@ bool Tracker::movesAcrossFace(const Track& t) const
   const Eigen::Vector2d across(-std::sin(m.yaw), std::cos(m.yaw));
   const Point2 common = commonMotionAt(t.position());
   const double speed = std::abs((t.x(2) - common.x) * across.x() + (t.x(3) - common.y) * across.y());
-  const double sigma = std::sqrt(std::max(0.0, across.dot(t.P.bottomRightCorner<2, 2>() * across)));
+  const double sigma = velocitySigmaAlong(t.P, across);
   return speed - params_.across_sigmas * sigma > params_.moving_speed;
 }
 
@@ -954,8 +918,7 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
       ++counts_.tracks_deleted;
       continue;
     }
-    if ((t.state == TrackState::kTentative && missed) ||
-        (t.state == TrackState::kCoasting && stamp - t.last_hit > params_.max_coast_time))
+    if (expired(t.state, missed, stamp - t.last_hit, lifecycleParams()))
     {
       ++counts_.tracks_deleted;
       continue;
@@ -1008,7 +971,7 @@ std::vector<char> Tracker::associate(double stamp)
     else
     {
       t.consecutive_hits = 0;
-      if (t.state == TrackState::kConfirmed) t.state = TrackState::kCoasting;
+      t.state = afterMiss(t.state);
     }
   }
   return used;
@@ -1073,49 +1036,12 @@ Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
   t.first_stamp = t.last_hit = stamp;
   t.measurement = measurement;
   t.background_unchecked = !background_known_;
-  if (params_.confirm_hits <= 1) t.state = TrackState::kConfirmed;
+  t.state = bornState(lifecycleParams());
   if (free_now_) seeFreeSpace(t, stamp);
   decideMotion(t, stamp);
   ++counts_.tracks_created;
   return t;
 }
-
-namespace {
-
-/// The cells of a grid of side @p cell that a square of half side @p r about @p c covers, as a range of indices per
-/// axis; empty (wide) when it spans more than kMaxGateCells cells or is not finite.
-struct CellSpan
-{
-  std::int64_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
-  bool wide = false;
-};
-
-CellSpan cellSpan(Point2 c, double r, double cell)
-{
-  const auto index = [&](double v) {
-    return static_cast<std::int64_t>(std::floor(std::clamp(v / cell, -kMaxCellCoordinate, kMaxCellCoordinate)));
-  };
-  CellSpan s;
-  if (!std::isfinite(r) || !(r / cell < kMaxGateCells))
-  {
-    s.wide = true;
-    return s;
-  }
-  s.x0 = index(c.x - r);
-  s.x1 = index(c.x + r);
-  s.y0 = index(c.y - r);
-  s.y1 = index(c.y + r);
-  s.wide = (s.x1 - s.x0 + 1) * (s.y1 - s.y0 + 1) > kMaxGateCells;
-  return s;
-}
-
-/// A cell's key; distinct cells may share one (a hash): that only adds candidates, which the gate judges.
-std::uint64_t gateKey(std::int64_t cx, std::int64_t cy)
-{
-  return (static_cast<std::uint64_t>(cx) << 32) ^ (static_cast<std::uint64_t>(cy) & 0xffffffffULL);
-}
-
-}  // namespace
 
 SparseCosts Tracker::gate() const
 {
@@ -1124,56 +1050,22 @@ SparseCosts Tracker::gate() const
   cost.cols = static_cast<int>(measurements_.size());
   if (cost.rows == 0 || cost.cols == 0) return cost;
   // The point a track follows (referencePoint()) lies within √2 c + ½ d of the cluster's centroid, c the farthest
-  // corner of the cluster's box from it and d the diagonal of the track's box: a measurement is indexed in the cells
-  // of a grid that its centroid's disc of radius max_gate_distance + √2 c touches, and a track looks in the cells its
-  // own disc of ½ d touches. The cost grows with the objects near each other, not with tracks × measurements. A
-  // measurement or track wider than kMaxGateCells cells (boxes no cluster has) is paired with every other side.
-  const double cell = std::max(params_.max_gate_distance, kMinGateCell);
-  std::vector<std::pair<std::uint64_t, int>> index;
-  std::vector<int> wide;  // measurements met by every track
-  std::vector<double> reach(measurements_.size());  // max_gate_distance + √2 c + slack, per measurement
-  for (int m = 0; m < cost.cols; ++m)
+  // corner of the cluster's box from it and d the diagonal of the track's box: a measurement's disc is its centroid's
+  // of radius max_gate_distance + √2 c, a track's its position's of radius ½ d; pairs whose discs do not meet are
+  // beyond the gate already.
+  std::vector<GateDisc> track_discs(tracks_.size()), measurement_discs(measurements_.size());
+  for (std::size_t m = 0; m < measurements_.size(); ++m)
   {
     const Measurement& z = measurements_[m];
     const double c = std::hypot(std::max(std::abs(z.lo_u), std::abs(z.hi_u)), std::max(std::abs(z.lo_v), std::abs(z.hi_v)));
-    reach[m] = params_.max_gate_distance + std::sqrt(2.0) * c + kGateSlack;
-    const CellSpan span = cellSpan(z.centroid, reach[m], cell);
-    if (span.wide) wide.push_back(m);
-    for (std::int64_t cx = span.x0; cx <= span.x1 && !span.wide; ++cx)
-      for (std::int64_t cy = span.y0; cy <= span.y1; ++cy) index.emplace_back(gateKey(cx, cy), m);
+    measurement_discs[m] = GateDisc{ z.centroid, params_.max_gate_distance + std::sqrt(2.0) * c + kGateSlack };
   }
-  std::sort(index.begin(), index.end());
-  std::vector<int> seen_by(measurements_.size(), -1);
-  // track_reach: ½ d + slack of track t.
-  const auto consider = [&](int t, double track_reach, int m) {
-    if (seen_by[m] == t) return;
-    seen_by[m] = t;
-    // The grid's cells are coarser than the discs: a pair whose discs do not meet is beyond the gate already.
-    const Point2 p = tracks_[t].position(), q = measurements_[m].centroid;
-    const double dx = p.x - q.x, dy = p.y - q.y, r = reach[m] + track_reach;
-    if (dx * dx + dy * dy > r * r) return;
+  for (std::size_t t = 0; t < tracks_.size(); ++t)
+    track_discs[t] = GateDisc{ tracks_[t].position(),
+                               0.5 * std::hypot(tracks_[t].extent_length, tracks_[t].extent_width) + kGateSlack };
+  const double cell = std::max(params_.max_gate_distance, kMinGateCell);
+  for (const auto& [t, m] : spatialGate(track_discs, measurement_discs, cell))
     if (const std::optional<double> d2 = gateCost(tracks_[t], measurements_[m])) cost.pairs.push_back(GatedPair{ t, m, *d2 });
-  };
-  for (int t = 0; t < cost.rows; ++t)
-  {
-    const Track& track = tracks_[t];
-    const double track_reach = 0.5 * std::hypot(track.extent_length, track.extent_width) + kGateSlack;
-    const CellSpan span = cellSpan(track.position(), track_reach, cell);
-    for (const int m : wide) consider(t, track_reach, m);
-    if (span.wide)
-    {
-      for (int m = 0; m < cost.cols; ++m) consider(t, track_reach, m);
-      continue;
-    }
-    for (std::int64_t cx = span.x0; cx <= span.x1; ++cx)
-      for (std::int64_t cy = span.y0; cy <= span.y1; ++cy)
-      {
-        const std::uint64_t k = gateKey(cx, cy);
-        auto it = std::lower_bound(index.begin(), index.end(), k,
-                                   [](const std::pair<std::uint64_t, int>& e, std::uint64_t v) { return e.first < v; });
-        for (; it != index.end() && it->first == k; ++it) consider(t, track_reach, it->second);
-      }
-  }
   return cost;
 }
 
@@ -1182,12 +1074,9 @@ std::optional<double> Tracker::gateCost(const Track& t, const Measurement& z) co
   if (z.split && std::max(t.extent_length, t.extent_width) > params_.background_split_size) return std::nullopt;
   const Point2 ref = referencePoint(t, z);
   const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
-  if (y.norm() > params_.max_gate_distance) return std::nullopt;
-  const Eigen::Matrix2d sm = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z, params_);
-  const double d2 = y.dot(sm.ldlt().solve(y));
-  // Not finite or negative when the predicted covariance lost its definiteness: no association.
-  if (std::isfinite(d2) && d2 >= 0.0 && d2 <= params_.gate) return d2;
-  return std::nullopt;
+  if (y.norm() > params_.max_gate_distance) return std::nullopt;  // before the covariance: most pairs end here
+  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z, params_);
+  return mahalanobisGate(y, s, params_.max_gate_distance, params_.gate);
 }
 
 void Tracker::rememberSeenBoxes()

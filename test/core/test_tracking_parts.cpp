@@ -5,9 +5,16 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
+#include <Eigen/LU>
+
+#include "map_aided_fusion/core/tracking/association.hpp"
 #include "map_aided_fusion/core/tracking/clustering.hpp"
+#include "map_aided_fusion/core/tracking/lifecycle.hpp"
+#include "map_aided_fusion/core/tracking/motion_decision.hpp"
+#include "map_aided_fusion/core/tracking/motion_model.hpp"
 #include "map_aided_fusion/core/tracking/shape_fit.hpp"
 
 namespace map_aided_fusion {
@@ -154,6 +161,235 @@ TEST(ShapeFit, ThePrincipalAxisWhenTheFitIsOffTooShortOrTooLong)
   EXPECT_EQ(one.mean, Eigen::Vector2d(points[3].x, points[3].y));
   EXPECT_EQ(one.length(), 0.0);
   EXPECT_EQ(one.width(), 0.0);
+}
+
+/// A random symmetric positive definite matrix: A Aᵀ + I·floor.
+template <int N>
+Eigen::Matrix<double, N, N> randomSpd(std::mt19937& rng, double floor)
+{
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix<double, N, N> a;
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) a(i, j) = u(rng);
+  return a * a.transpose() + floor * Eigen::Matrix<double, N, N>::Identity();
+}
+
+TEST(MotionModel, PredictionMovesAtConstantVelocityAndAddsTheWhiteNoiseAccelerationCovariance)
+{
+  std::mt19937 rng(5);
+  const Eigen::Matrix4d p0 = randomSpd<4>(rng, 0.1);
+  Eigen::Vector4d x(1.0, 2.0, 3.0, -1.0);
+  Eigen::Matrix4d p = p0;
+  const double dt = 0.3, sa = 0.7;
+  predictConstantVelocity(x, p, dt, sa);
+  EXPECT_NEAR(x(0), 1.0 + 3.0 * dt, 1e-15);
+  EXPECT_NEAR(x(1), 2.0 - 1.0 * dt, 1e-15);
+  EXPECT_EQ(x(2), 3.0);
+  EXPECT_EQ(x(3), -1.0);
+  // Element by element: P'ij = Σ F_ik P_kl F_jl + Q_ij, F = I + dt (e₀e₂ᵀ + e₁e₃ᵀ).
+  auto f = [dt](int i, int k) { return (i == k ? 1.0 : 0.0) + ((i == 0 && k == 2) || (i == 1 && k == 3) ? dt : 0.0); };
+  const double q = sa * sa;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+    {
+      double expected = 0.0;
+      for (int k = 0; k < 4; ++k)
+        for (int l = 0; l < 4; ++l) expected += f(i, k) * p0(k, l) * f(j, l);
+      const bool pos_i = i < 2, pos_j = j < 2, same_axis = i % 2 == j % 2;
+      if (same_axis)
+        expected += pos_i && pos_j ? q * std::pow(dt, 4) / 4.0 : (pos_i || pos_j ? q * std::pow(dt, 3) / 2.0 : q * dt * dt);
+      EXPECT_NEAR(p(i, j), expected, 1e-12) << i << "," << j;
+    }
+  // No time, no change.
+  Eigen::Vector4d x0 = x;
+  Eigen::Matrix4d p1 = p;
+  predictConstantVelocity(x0, p1, 0.0, sa);
+  EXPECT_EQ(x0, x);
+  EXPECT_EQ(p1, p);
+}
+
+TEST(MotionModel, CorrectionEqualsTheInformationFormOfTheKalmanUpdate)
+{
+  std::mt19937 rng(6);
+  Eigen::Matrix<double, 2, 4> h = Eigen::Matrix<double, 2, 4>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  for (int trial = 0; trial < 20; ++trial)
+  {
+    const Eigen::Matrix4d p0 = randomSpd<4>(rng, 0.05);
+    const Eigen::Matrix2d r = randomSpd<2>(rng, 0.01);
+    const Eigen::Vector4d x0 = Eigen::Vector4d::Random();
+    const Eigen::Vector2d z = Eigen::Vector2d::Random();
+    Eigen::Vector4d x = x0;
+    Eigen::Matrix4d p = p0;
+    correctPosition(x, p, z, r);
+    // (P⁻¹ + Hᵀ R⁻¹ H)⁻¹ and P' (P⁻¹ x + Hᵀ R⁻¹ z).
+    const Eigen::Matrix4d info = p0.inverse() + h.transpose() * r.inverse() * h;
+    const Eigen::Matrix4d expected_p = info.inverse();
+    const Eigen::Vector4d expected_x = expected_p * (p0.inverse() * x0 + h.transpose() * r.inverse() * z);
+    EXPECT_LT((p - expected_p).cwiseAbs().maxCoeff(), 1e-9) << trial;
+    EXPECT_LT((x - expected_x).cwiseAbs().maxCoeff(), 1e-9) << trial;
+    EXPECT_LT((p - p.transpose()).cwiseAbs().maxCoeff(), 1e-12) << trial;
+  }
+}
+
+TEST(MotionModel, AnExactMeasurementPinsThePositionAndAVagueOneChangesNothing)
+{
+  const Eigen::Vector4d x0(1.0, 1.0, 2.0, 0.0);
+  const Eigen::Matrix4d p0 = Eigen::Matrix4d::Identity();
+  const Eigen::Vector2d z(3.0, -2.0);
+  Eigen::Vector4d x = x0;
+  Eigen::Matrix4d p = p0;
+  correctPosition(x, p, z, 1e-12 * Eigen::Matrix2d::Identity());
+  EXPECT_NEAR(x(0), 3.0, 1e-9);
+  EXPECT_NEAR(x(1), -2.0, 1e-9);
+  EXPECT_NEAR(p(0, 0), 0.0, 1e-9);
+  // Position and velocity uncorrelated in P: the velocity learns nothing.
+  EXPECT_EQ(x(2), 2.0);
+  EXPECT_EQ(x(3), 0.0);
+  x = x0;
+  p = p0;
+  correctPosition(x, p, z, 1e12 * Eigen::Matrix2d::Identity());
+  EXPECT_LT((x - x0).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((p - p0).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(MotionModel, TheSpeedSigmaIsAlongTheVelocityOrTheLargestWithoutOne)
+{
+  Eigen::Matrix4d p = Eigen::Matrix4d::Identity();
+  p(2, 2) = 4.0;  // σ(vx) = 2
+  p(3, 3) = 1.0;  // σ(vy) = 1
+  EXPECT_DOUBLE_EQ(speedSigma(Eigen::Vector4d(0, 0, 5.0, 0.0), p), 2.0);
+  EXPECT_DOUBLE_EQ(speedSigma(Eigen::Vector4d(0, 0, 0.0, -3.0), p), 1.0);
+  EXPECT_NEAR(speedSigma(Eigen::Vector4d::Zero(), p), 2.0, 1e-12);
+  // Along (1, 1)/√2: √((4 + 1 + 2·c) / 2) with the covariance c.
+  p(2, 3) = p(3, 2) = 0.5;
+  EXPECT_NEAR(speedSigma(Eigen::Vector4d(0, 0, 1.0, 1.0), p), std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(velocitySigmaAlong(p, Eigen::Vector2d(1.0, -1.0).normalized()), std::sqrt(2.0), 1e-12);
+}
+
+/// The candidate pairs by definition: every (row, column) whose discs meet.
+std::vector<std::pair<int, int>> meetingDiscs(const std::vector<GateDisc>& rows, const std::vector<GateDisc>& cols)
+{
+  std::vector<std::pair<int, int>> out;
+  for (int i = 0; i < static_cast<int>(rows.size()); ++i)
+    for (int j = 0; j < static_cast<int>(cols.size()); ++j)
+      if (std::hypot(rows[i].centre.x - cols[j].centre.x, rows[i].centre.y - cols[j].centre.y) <=
+          rows[i].radius + cols[j].radius)
+        out.emplace_back(i, j);
+  return out;
+}
+
+TEST(Association, TheSpatialGateFindsEveryPairOfMeetingDiscsOnce)
+{
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> pos(-60.0, 60.0), rad(0.0, 4.0);
+  for (int trial = 0; trial < 20; ++trial)
+  {
+    std::vector<GateDisc> rows(30), cols(40);
+    for (GateDisc& d : rows) d = GateDisc{ Point2{ pos(rng), pos(rng) }, rad(rng) };
+    for (GateDisc& d : cols) d = GateDisc{ Point2{ pos(rng), pos(rng) }, rad(rng) };
+    if (trial % 4 == 1) cols[3].radius = 5000.0;  // wider than kMaxGateCells cells: met through the wide list
+    if (trial % 4 == 2) rows[5].radius = std::numeric_limits<double>::infinity();
+    if (trial % 4 == 3) cols[7].centre.x = std::numeric_limits<double>::quiet_NaN();
+    const double cell = trial % 2 ? 2.0 : 0.5;
+    std::vector<std::pair<int, int>> found = spatialGate(rows, cols, cell);
+    EXPECT_TRUE(std::is_sorted(found.begin(), found.end(),
+                               [](const auto& a, const auto& b) { return a.first < b.first; }));
+    std::vector<std::pair<int, int>> sorted = found;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "a pair twice";
+    EXPECT_EQ(sorted, meetingDiscs(rows, cols)) << trial;
+  }
+  EXPECT_TRUE(spatialGate({}, { GateDisc{} }, 1.0).empty());
+  EXPECT_TRUE(spatialGate({ GateDisc{} }, {}, 1.0).empty());
+  EXPECT_TRUE(spatialGate({ GateDisc{} }, { GateDisc{} }, 0.0).empty());
+  // Touching discs meet; a millimetre apart they do not.
+  EXPECT_EQ(spatialGate({ GateDisc{ Point2{ 0.0, 0.0 }, 1.0 } }, { GateDisc{ Point2{ 2.0, 0.0 }, 1.0 } }, 1.0).size(), 1u);
+  EXPECT_TRUE(spatialGate({ GateDisc{ Point2{ 0.0, 0.0 }, 1.0 } }, { GateDisc{ Point2{ 2.001, 0.0 }, 1.0 } }, 1.0).empty());
+}
+
+TEST(Association, TheStatisticalGateIsTheMahalanobisDistanceWithinBothGates)
+{
+  const Eigen::Vector2d y(3.0, 4.0);  // |y| = 5
+  const Eigen::Matrix2d s = Eigen::Vector2d(4.0, 16.0).asDiagonal();
+  const double d2 = 9.0 / 4.0 + 16.0 / 16.0;
+  ASSERT_TRUE(mahalanobisGate(y, s, 10.0, 9.21).has_value());
+  EXPECT_DOUBLE_EQ(*mahalanobisGate(y, s, 10.0, 9.21), d2);
+  EXPECT_DOUBLE_EQ(*mahalanobisGate(y, s, 5.0, d2), d2);  // both limits inclusive
+  EXPECT_FALSE(mahalanobisGate(y, s, 4.99, 9.21).has_value());
+  EXPECT_FALSE(mahalanobisGate(y, s, 10.0, 3.0).has_value());
+  // A covariance that lost its definiteness gives no pair.
+  EXPECT_FALSE(mahalanobisGate(y, -s, 10.0, 9.21).has_value());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(mahalanobisGate(y, Eigen::Matrix2d::Constant(nan), 10.0, 9.21).has_value());
+}
+
+TEST(MotionDecision, MovingWhenTheSpeedClearsTheFloorByTheSigmas)
+{
+  const MotionDecisionParams p;  // moving 0.5 m/s, 1.5 σ; with free space 0.5 σ
+  double still = -1.0;
+  MotionEvidence e;
+  e.speed = 2.0;
+  e.speed_sigma = 0.5;  // 2 − 0.75 > 0.5
+  EXPECT_EQ(decideMotion(e, 1.0, still, p), TrackMotion::kMoving);
+  e.tentative = true;
+  still = 0.25;
+  EXPECT_EQ(decideMotion(e, 1.0, still, p), TrackMotion::kUnknown);
+  EXPECT_EQ(still, 0.25) << "a tentative track's stillness is left as it is";
+  e.tentative = false;
+  e.speed = 0.5 + 1.5 * 0.5;  // exactly on the floor: not cleared
+  EXPECT_EQ(decideMotion(e, 1.0, still, p), TrackMotion::kUnknown);
+  // With the free-space check: fewer sigmas, but only once free space has shown the motion.
+  e.speed = 1.0;  // 1 − 0.25 > 0.5, 1 − 0.75 < 0.5
+  e.free_space_check = true;
+  EXPECT_EQ(decideMotion(e, 1.0, still, p), TrackMotion::kUnknown);
+  e.motion_seen = true;
+  EXPECT_EQ(decideMotion(e, 1.0, still, p), TrackMotion::kMoving);
+  e.free_space_check = false;
+  EXPECT_EQ(decideMotion(e, 1.0, still, p), TrackMotion::kUnknown);
+  EXPECT_TRUE(clearsSpeed(1.0, 0.25, 1.0, 0.5));
+  EXPECT_FALSE(clearsSpeed(1.0, 0.5, 1.0, 0.5));
+}
+
+TEST(MotionDecision, StoppedOnlyAfterStandingStillForTheStoppedTime)
+{
+  const MotionDecisionParams p;  // stopped below 0.8 m/s at 1.5 σ for 1 s
+  MotionEvidence slow;
+  slow.speed = 0.1;
+  slow.speed_sigma = 0.1;  // 0.1 + 0.15 < 0.8
+  double still = -1.0;
+  EXPECT_EQ(decideMotion(slow, 10.0, still, p), TrackMotion::kUnknown);
+  EXPECT_EQ(still, 10.0);
+  EXPECT_EQ(decideMotion(slow, 10.5, still, p), TrackMotion::kUnknown);
+  EXPECT_EQ(decideMotion(slow, 11.0, still, p), TrackMotion::kStopped);
+  EXPECT_EQ(still, 10.0);
+  // Not confidently slow (its σ): stillness is over, and starts again from the next slow scan.
+  MotionEvidence unsure = slow;
+  unsure.speed_sigma = 0.5;  // 0.1 + 0.75 ≥ 0.8
+  EXPECT_EQ(decideMotion(unsure, 11.1, still, p), TrackMotion::kUnknown);
+  EXPECT_EQ(still, -1.0);
+  EXPECT_EQ(decideMotion(slow, 11.2, still, p), TrackMotion::kUnknown);
+  EXPECT_EQ(decideMotion(slow, 12.2, still, p), TrackMotion::kStopped);
+}
+
+TEST(Lifecycle, SpawnConfirmCoastAndPrune)
+{
+  const LifecycleParams p{ 3, 0.5 };
+  EXPECT_EQ(bornState(p), TrackState::kTentative);
+  EXPECT_EQ(bornState(LifecycleParams{ 1, 0.5 }), TrackState::kConfirmed);
+  EXPECT_EQ(afterHit(TrackState::kTentative, 2, p), TrackState::kTentative);
+  EXPECT_EQ(afterHit(TrackState::kTentative, 3, p), TrackState::kConfirmed);
+  EXPECT_EQ(afterHit(TrackState::kConfirmed, 1, p), TrackState::kConfirmed);
+  EXPECT_EQ(afterHit(TrackState::kCoasting, 1, p), TrackState::kConfirmed);
+  EXPECT_EQ(afterMiss(TrackState::kConfirmed), TrackState::kCoasting);
+  EXPECT_EQ(afterMiss(TrackState::kCoasting), TrackState::kCoasting);
+  EXPECT_EQ(afterMiss(TrackState::kTentative), TrackState::kTentative);
+  // A tentative track dies at its first miss; a coasting one after max_coast_time unseen; a confirmed one never.
+  EXPECT_TRUE(expired(TrackState::kTentative, true, 0.1, p));
+  EXPECT_FALSE(expired(TrackState::kTentative, false, 0.0, p));
+  EXPECT_FALSE(expired(TrackState::kCoasting, true, 0.5, p));
+  EXPECT_TRUE(expired(TrackState::kCoasting, true, 0.51, p));
+  EXPECT_FALSE(expired(TrackState::kConfirmed, true, 10.0, p));
 }
 
 }  // namespace

@@ -25,6 +25,8 @@
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
 #include "map_aided_fusion/core/seen_free.hpp"
+#include "map_aided_fusion/core/tracking/lifecycle.hpp"
+#include "map_aided_fusion/core/tracking/motion_decision.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -446,22 +448,6 @@ bool hiddenFromSensor(const ScanMassGrid& scan, const Pose2& pose, Point2 p, dou
 std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& params,
                                         const std::vector<std::uint8_t>* background = nullptr);
 
-/// Lifecycle of a track.
-enum class TrackState : std::uint8_t
-{
-  kTentative,  ///< fewer than confirm_hits associations so far
-  kConfirmed,
-  kCoasting,   ///< confirmed, not associated in the last scan(s)
-};
-
-/// Motion decision of a track.
-enum class TrackMotion : std::uint8_t
-{
-  kUnknown,
-  kMoving,   ///< speed − motion_sigmas · σ above moving_speed (and, with the free-space check, Track::motion_seen)
-  kStopped,  ///< speed + motion_sigmas · σ below stopped_speed for stopped_time
-};
-
 /// Where a track's returns were in one scan (at most Tracker::kSightingPoints of them, map frame).
 struct Sighting
 {
@@ -659,6 +645,7 @@ public:
 
 private:
   void predict(Track& t, double dt) const;
+  LifecycleParams lifecycleParams() const { return LifecycleParams{ params_.confirm_hits, params_.max_coast_time }; }
   /// Keeps the max_measurements of @p found nearest the sensor (counted); records the peak.
   void capMeasurements(std::vector<Measurement>& found);
   /// Predicted tracks × measurements_: the gated global assignment and the corrections; which measurements it used.
