@@ -10,6 +10,7 @@
 #include "map_aided_fusion/core/stamp_guard.hpp"
 #include "map_aided_fusion/core/tracking/clustering.hpp"
 #include "map_aided_fusion/core/tracking/association.hpp"
+#include "map_aided_fusion/core/tracking/common_motion.hpp"
 #include "map_aided_fusion/core/tracking/motion_model.hpp"
 #include "map_aided_fusion/core/tracking/shape_fit.hpp"
 
@@ -46,9 +47,6 @@ constexpr double kMaxBoxFitCloseness = 1.0;  // m: box_fit_closeness, beyond any
 constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
 constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
 constexpr double kMaxCommonTurnRate = 1.0;  // rad/s: common_motion_max_turn_rate, far beyond any drift
-constexpr int kCommonTurnIterations = 10;   // reweightings of step common turn's fit
-constexpr double kMinCommonSigma = 0.01;    // m/s: a track's σ(speed) in that fit is never below
-constexpr double kCommonTurnSolveTolerance = 1e-9;  // relative residual of its normal equations: above, singular
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
 const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
 
@@ -492,9 +490,7 @@ void Tracker::reset()
   tracks_.clear();
   seen_free_.clear();
   last_stamp_ = -1.0;
-  common_motion_ = Point2{ 0.0, 0.0 };
-  has_common_motion_ = false;
-  common_turn_rate_ = 0.0;
+  common_ = CommonMotion{};
 }
 
 void Tracker::predict(Track& t, double dt) const { predictConstantVelocity(t.x, t.P, dt, params_.acceleration_sigma); }
@@ -573,92 +569,22 @@ bool Tracker::fastEnough(const Track& t, double sigmas) const
   return clearsSpeed(decisionSpeed(t), t.speedSigma(), sigmas, params_.moving_speed);
 }
 
-Tracker::CommonFit Tracker::fitCommonTurn(Point2 start) const
-{
-  Eigen::Vector3d theta(start.x, start.y, 0.0);
-  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-  auto residual = [&theta](const SeenVelocity& s) {
-    return Eigen::Vector2d(s.v.x() - theta(0) + theta(2) * s.r.y(), s.v.y() - theta(1) - theta(2) * s.r.x());
-  };
-  for (int iteration = 0; iteration < kCommonTurnIterations; ++iteration)
-  {
-    a.setZero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
-    for (const SeenVelocity& s : common_seen_)
-    {
-      const double z = residual(s).norm() / s.sigma, k = params_.common_motion_sigmas;
-      const double w = (z <= k ? 1.0 : k / z) / (s.sigma * s.sigma);
-      const Eigen::Vector3d jx(1.0, 0.0, -s.r.y()), jy(0.0, 1.0, s.r.x());
-      a += w * (jx * jx.transpose() + jy * jy.transpose());
-      b += w * (jx * s.v.x() + jy * s.v.y());
-    }
-    const Eigen::Vector3d next = a.ldlt().solve(b);
-    if (!next.allFinite() || !((a * next - b).norm() <= kCommonTurnSolveTolerance * (b.norm() + 1.0)))
-      return CommonFit{ Point2{ 0.0, 0.0 }, std::nan(""), 0.0, 0 };
-    theta = next;
-  }
-  const long agree = std::count_if(common_seen_.begin(), common_seen_.end(), [&](const SeenVelocity& s) {
-    return residual(s).norm() <= params_.common_motion_sigmas * s.sigma;
-  });
-  const double turn_variance = a.inverse()(2, 2);
-  return CommonFit{ Point2{ theta(0), theta(1) }, theta(2), std::sqrt(std::max(0.0, turn_variance)), agree };
-}
-
 void Tracker::findCommonMotion(double stamp)
 {
-  common_motion_ = Point2{ 0.0, 0.0 };
-  has_common_motion_ = false;
-  common_turn_rate_ = 0.0;
+  common_ = CommonMotion{};
   if (!params_.common_motion) return;
-  common_vx_.clear();
-  common_vy_.clear();
   common_seen_.clear();
-  auto seen = [&](const Track& t) { return t.reported() && t.last_hit >= stamp && finite(t.x, t.P); };
   for (const Track& t : tracks_)
-    if (seen(t))
-    {
-      common_vx_.push_back(t.x(2));
-      common_vy_.push_back(t.x(3));
-    }
-  const std::size_t n = common_vx_.size();
-  if (n < static_cast<std::size_t>(params_.common_motion_min_tracks)) return;
-  auto median = [n](std::vector<double>& v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n / 2), v.end());
-    return v[n / 2];
-  };
-  Point2 m{ median(common_vx_), median(common_vy_) };
-  auto agree = std::count_if(tracks_.begin(), tracks_.end(), [&](const Track& t) {
-    return seen(t) && t.speedRelativeTo(m) <= params_.common_motion_sigmas * t.speedSigma();
-  });
+    if (t.reported() && t.last_hit >= stamp && finite(t.x, t.P))
+      common_seen_.push_back(SeenTrack{ t.position(), t.velocity(), t.speedSigma() });
   const auto sensor =
       std::find_if(measurements_.begin(), measurements_.end(), [](const Measurement& x) { return x.has_sensor; });
-  if (params_.common_turn && sensor != measurements_.end())
-  {
-    common_centre_ = sensor->sensor;
-    for (const Track& t : tracks_)
-      if (seen(t))
-        common_seen_.push_back(SeenVelocity{ Eigen::Vector2d(t.x(0) - common_centre_.x, t.x(1) - common_centre_.y),
-                                             t.x.tail<2>(), std::max(t.speedSigma(), kMinCommonSigma) });
-    const CommonFit fit = fitCommonTurn(m);
-    if (std::abs(fit.turn_rate) <= params_.common_motion_max_turn_rate &&
-        std::abs(fit.turn_rate) > params_.common_motion_sigmas * fit.turn_sigma && fit.agree > agree &&
-        std::hypot(fit.v.x, fit.v.y) <= params_.common_motion_max_speed)
-    {
-      m = fit.v;
-      agree = fit.agree;
-      common_turn_rate_ = fit.turn_rate;
-    }
-  }
-  if (!(std::hypot(m.x, m.y) <= params_.common_motion_max_speed) ||
-      !(static_cast<double>(agree) > params_.common_motion_share * static_cast<double>(n)))
-  {
-    common_turn_rate_ = 0.0;
-    return;
-  }
-  common_motion_ = m;
-  has_common_motion_ = true;
-  ++counts_.common_motion_scans;
-  if (common_turn_rate_ != 0.0) ++counts_.common_turn_scans;
+  const CommonMotionParams p{ params_.common_motion_min_tracks, params_.common_motion_share,
+                              params_.common_motion_sigmas,     params_.common_motion_max_speed,
+                              params_.common_turn,              params_.common_motion_max_turn_rate };
+  common_ = fitCommonMotion(common_seen_, sensor != measurements_.end() ? &sensor->sensor : nullptr, p);
+  counts_.common_motion_scans += common_.found;
+  counts_.common_turn_scans += common_.found && common_.turn_rate != 0.0;
 }
 
 void Tracker::decideMotion(Track& t, double stamp) const

@@ -12,6 +12,7 @@
 
 #include "map_aided_fusion/core/tracking/association.hpp"
 #include "map_aided_fusion/core/tracking/clustering.hpp"
+#include "map_aided_fusion/core/tracking/common_motion.hpp"
 #include "map_aided_fusion/core/tracking/lifecycle.hpp"
 #include "map_aided_fusion/core/tracking/motion_decision.hpp"
 #include "map_aided_fusion/core/tracking/motion_model.hpp"
@@ -390,6 +391,68 @@ TEST(Lifecycle, SpawnConfirmCoastAndPrune)
   EXPECT_FALSE(expired(TrackState::kCoasting, true, 0.5, p));
   EXPECT_TRUE(expired(TrackState::kCoasting, true, 0.51, p));
   EXPECT_FALSE(expired(TrackState::kConfirmed, true, 10.0, p));
+}
+
+/// @p n tracks on a ring of radius 5–40 m around @p sensor moving with the rigid motion v0 + ω × (p − sensor).
+std::vector<SeenTrack> rigidlyMoving(int n, Point2 sensor, Point2 v0, double omega, double sigma)
+{
+  std::vector<SeenTrack> seen;
+  for (int i = 0; i < n; ++i)
+  {
+    const double a = 2.0 * M_PI * i / n, r = 5.0 + 35.0 * i / n;
+    const Point2 p{ sensor.x + r * std::cos(a), sensor.y + r * std::sin(a) };
+    seen.push_back(SeenTrack{ p, Point2{ v0.x - omega * (p.y - sensor.y), v0.y + omega * (p.x - sensor.x) }, sigma });
+  }
+  return seen;
+}
+
+TEST(CommonMotion, ASharedDriftIsFoundAndATurnAboutTheSensorIsFitted)
+{
+  const CommonMotionParams p;  // 20 tracks, more than half agreeing, ≤ 2 m/s, ≤ 0.05 rad/s
+  const Point2 sensor{ 100.0, -20.0 };
+  // The same velocity everywhere: the median; no turn.
+  const CommonMotion drift = fitCommonMotion(rigidlyMoving(25, sensor, Point2{ 0.8, -0.4 }, 0.0, 0.2), &sensor, p);
+  ASSERT_TRUE(drift.found);
+  EXPECT_EQ(drift.velocity.x, 0.8);
+  EXPECT_EQ(drift.velocity.y, -0.4);
+  EXPECT_EQ(drift.turn_rate, 0.0);
+  // A heading drift of 0.03 rad/s: v₀ and ω of the rigid motion.
+  const std::vector<SeenTrack> turning = rigidlyMoving(25, sensor, Point2{ 0.3, 0.1 }, 0.03, 0.2);
+  const CommonMotion turn = fitCommonMotion(turning, &sensor, p);
+  ASSERT_TRUE(turn.found);
+  EXPECT_NEAR(turn.turn_rate, 0.03, 1e-9);
+  EXPECT_NEAR(turn.velocity.x, 0.3, 1e-9);
+  EXPECT_NEAR(turn.velocity.y, 0.1, 1e-9);
+  for (const SeenTrack& s : turning)
+  {
+    EXPECT_NEAR(turn.at(s.position).x, s.velocity.x, 1e-8);
+    EXPECT_NEAR(turn.at(s.position).y, s.velocity.y, 1e-8);
+  }
+  // Without the sensor, or with the turn off, no turn: the median's few agree (far tracks move faster), not found.
+  CommonMotionParams no_turn = p;
+  no_turn.turn = false;
+  EXPECT_FALSE(fitCommonMotion(turning, &sensor, no_turn).found);
+  EXPECT_FALSE(fitCommonMotion(turning, nullptr, p).found);
+  // Turning faster than max_turn_rate is not a drift.
+  EXPECT_FALSE(fitCommonMotion(rigidlyMoving(25, sensor, Point2{ 0.3, 0.1 }, 0.2, 0.2), &sensor, p).found);
+}
+
+TEST(CommonMotion, TooFewTracksTrafficOrAMixIsNoCommonMotion)
+{
+  const CommonMotionParams p;
+  const Point2 sensor{ 0.0, 0.0 };
+  EXPECT_FALSE(fitCommonMotion(rigidlyMoving(19, sensor, Point2{ 0.5, 0.0 }, 0.0, 0.2), &sensor, p).found);
+  EXPECT_TRUE(fitCommonMotion(rigidlyMoving(20, sensor, Point2{ 0.5, 0.0 }, 0.0, 0.2), &sensor, p).found);
+  EXPECT_FALSE(fitCommonMotion({}, &sensor, p).found);
+  // Faster than max_speed: traffic.
+  EXPECT_FALSE(fitCommonMotion(rigidlyMoving(25, sensor, Point2{ 2.5, 0.0 }, 0.0, 0.2), &sensor, p).found);
+  // Half one way, half the other: no motion shared by more than half.
+  std::vector<SeenTrack> mix = rigidlyMoving(12, sensor, Point2{ 1.0, 0.0 }, 0.0, 0.1);
+  for (const SeenTrack& s : rigidlyMoving(12, sensor, Point2{ -1.0, 0.0 }, 0.0, 0.1)) mix.push_back(s);
+  const CommonMotion none = fitCommonMotion(mix, &sensor, p);
+  EXPECT_FALSE(none.found);
+  EXPECT_EQ(none.velocity.x, 0.0);
+  EXPECT_EQ(none.turn_rate, 0.0);
 }
 
 }  // namespace

@@ -25,6 +25,7 @@
 #include "map_aided_fusion/core/grid_geometry.hpp"
 #include "map_aided_fusion/core/mass_grid.hpp"
 #include "map_aided_fusion/core/seen_free.hpp"
+#include "map_aided_fusion/core/tracking/common_motion.hpp"
 #include "map_aided_fusion/core/tracking/lifecycle.hpp"
 #include "map_aided_fusion/core/tracking/motion_decision.hpp"
 
@@ -623,16 +624,12 @@ public:
   const TrackerCounts& counts() const { return counts_; }
   const TrackerParams& params() const { return params_; }
   /// Step common motion: the last scan's common motion (m/s, map frame) at the sensor, (0, 0) when it had none.
-  Point2 commonMotion() const { return common_motion_; }
-  bool hasCommonMotion() const { return has_common_motion_; }
+  Point2 commonMotion() const { return common_.velocity; }
+  bool hasCommonMotion() const { return common_.found; }
   /// Step common turn: the last scan's common motion's turn rate (rad/s, counter-clockwise), 0 when it does not turn.
-  double commonTurnRate() const { return common_turn_rate_; }
+  double commonTurnRate() const { return common_.turn_rate; }
   /// The last scan's common motion at @p p (map frame): commonMotion() + ω × (p − sensor).
-  Point2 commonMotionAt(Point2 p) const
-  {
-    return Point2{ common_motion_.x - common_turn_rate_ * (p.y - common_centre_.y),
-                   common_motion_.y + common_turn_rate_ * (p.x - common_centre_.x) };
-  }
+  Point2 commonMotionAt(Point2 p) const { return common_.at(p); }
   /// The speed the motion decision takes: relative to the common motion at the track.
   double decisionSpeed(const Track& t) const { return t.speedRelativeTo(commonMotionAt(t.position())); }
   /// Whether the returns' background flags of the next update() can already mark static background (trackScan():
@@ -686,27 +683,8 @@ private:
   std::vector<std::uint8_t> map_flags_;
   std::deque<SeenFree> seen_free_;  ///< the free space of the scans of the last free_space_time, oldest first
   bool free_now_ = false;           ///< seen_free_ holds this scan's (the check runs)
-  Point2 common_motion_;            ///< step common motion, m/s at common_centre_; (0, 0) when none
-  bool has_common_motion_ = false;
-  double common_turn_rate_ = 0.0;   ///< step common turn, rad/s; 0 when none
-  Point2 common_centre_;            ///< the sensor position the common motion turns about
-  std::vector<double> common_vx_, common_vy_;  ///< its buffers
-  /// Step common turn: a seen track's position relative to the sensor, velocity and σ(speed).
-  struct SeenVelocity
-  {
-    Eigen::Vector2d r, v;
-    double sigma;
-  };
-  std::vector<SeenVelocity> common_seen_;
-  /// Step common turn: fits the turning common motion to common_seen_ from @p start (v₀ at the sensor, ω = 0) and
-  /// returns v₀, ω, σ(ω) and how many tracks agree with it; ω is NaN when the fit is singular.
-  struct CommonFit
-  {
-    Point2 v;
-    double turn_rate, turn_sigma;
-    long agree;
-  };
-  CommonFit fitCommonTurn(Point2 start) const;
+  CommonMotion common_;             ///< steps common motion and common turn: the last scan's
+  std::vector<SeenTrack> common_seen_;  ///< its buffer
   TrackerCounts counts_;
   std::uint32_t next_id_ = 1;
   double last_stamp_ = -1.0;
