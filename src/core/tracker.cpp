@@ -214,7 +214,6 @@ void TrackerParams::validate() const
   requireInRange("tracker_free_space_small_size", free_space_small_size, 0.0, max_object_width);
   requireInRange("tracker_free_space_small_margin", free_space_small_margin, 0.0, free_space_margin);
   requireInRange("tracker_free_space_small_min_extent", free_space_small_min_extent, 0.0, max_object_width);
-  requireInRange("tracker_free_space_small_widest", free_space_small_widest, 0.0, max_object_width);
   requireInRange("tracker_free_space_small_max_speed", free_space_small_max_speed, 0.0, max_speed);
   requireInRange("tracker_evidence_hidden_length", evidence_hidden_length, 0.0, max_object_length);
   requireInRange("tracker_evidence_end_width", evidence_end_width, 0.0, max_object_width);
@@ -228,10 +227,6 @@ void TrackerParams::validate() const
   requireInRange("tracker_common_motion_max_speed", common_motion_max_speed, 0.0, max_speed);
   requireInRange("tracker_long_box_min_length", long_box_min_length, 0.0, kMaxLongBoxMinLength);
   requireInRange("tracker_common_motion_max_turn_rate", common_motion_max_turn_rate, 0.0, kMaxCommonTurnRate);
-  requireInRange("tracker_across_min_hits", across_min_hits, 1, 100000);
-  requireInRange("tracker_across_min_length", across_min_length, 0.0, max_object_length);
-  requireInRange("tracker_across_max_width_share", across_max_width_share, kMinShare, 1.0);
-  requireInRange("tracker_across_sigmas", across_sigmas, 0.0, 10.0);
   requirePositive("tracker_background_split_size", background_split_size);
   requireInRange("tracker_background_split_size", background_split_size, 0.0, max_object_width);
   requireInRange("tracker_walk_min_hits", walk_min_hits, 1, 100000);
@@ -519,8 +514,6 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
-  t.widest_length = std::max(t.widest_length, m.length);
-  t.widest_width = std::max(t.widest_width, m.width);
   if (t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed)
   {
     const double heading = std::atan2(t.x(3), t.x(2));
@@ -605,25 +598,10 @@ void Tracker::decideMotion(Track& t, double stamp) const
 
 bool Tracker::smallWalker(const Track& t) const
 {
-  const double small = params_.free_space_small_size, least = params_.free_space_small_min_extent,
-               widest = params_.free_space_small_widest;
-  const bool thick = (t.extent_length >= least && t.extent_width >= least) ||
-                     (widest > 0.0 && t.widest_length >= widest && t.widest_width >= widest);
+  const double small = params_.free_space_small_size, least = params_.free_space_small_min_extent;
+  const bool thick = t.extent_length >= least && t.extent_width >= least;
   return small > 0.0 && t.extent_length <= small && t.extent_width <= small && thick &&
          t.speed() <= params_.free_space_small_max_speed;
-}
-
-bool Tracker::movesAcrossFace(const Track& t) const
-{
-  if (t.state == TrackState::kTentative || t.measurement < 0) return false;
-  if (t.consecutive_hits < params_.across_min_hits) return false;
-  const Measurement& m = measurements_[t.measurement];
-  if (m.length < params_.across_min_length || m.width > params_.across_max_width_share * m.length) return false;
-  const Eigen::Vector2d across(-std::sin(m.yaw), std::cos(m.yaw));
-  const Point2 common = commonMotionAt(t.position());
-  const double speed = std::abs((t.x(2) - common.x) * across.x() + (t.x(3) - common.y) * across.y());
-  const double sigma = velocitySigmaAlong(t.P, across);
-  return speed - params_.across_sigmas * sigma > params_.moving_speed;
 }
 
 void Tracker::seeFreeSpace(Track& t, double stamp)
@@ -655,11 +633,6 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     const auto came = std::count_if(now.points.begin(), now.points.end(), seenFreeBefore);
     t.motion_seen = left || (!now.points.empty() && static_cast<double>(came) >=
                                                         params_.free_space_share * static_cast<double>(now.points.size()));
-    if (!t.motion_seen && params_.across_face && movesAcrossFace(t))
-    {
-      t.motion_seen = true;
-      ++counts_.across_face;
-    }
     if (!t.motion_seen && params_.walked && small && t.consecutive_hits >= params_.walk_min_hits &&
         !t.sightings.empty())
     {
@@ -956,8 +929,8 @@ Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
   t.P.topLeftCorner<2, 2>() = z.covariance;
   t.P(2, 2) = t.P(3, 3) = params_.initial_speed_sigma * params_.initial_speed_sigma;
   t.yaw = t.extent_yaw = z.yaw;
-  t.length = t.extent_length = t.widest_length = z.length;
-  t.width = t.extent_width = t.widest_width = z.width;
+  t.length = t.extent_length = z.length;
+  t.width = t.extent_width = z.width;
   t.hits = t.consecutive_hits = 1;
   t.first_stamp = t.last_hit = stamp;
   t.measurement = measurement;

@@ -913,7 +913,6 @@ void FusionWorker::diagnoseTracker(diagnostic_updater::DiagnosticStatusWrapper& 
       status.add("common motion's turn rate (last scan) [deg/s]", w.str());
     }
     status.add("scans whose common motion turns", c.common_turn_scans);
-    status.add("tracks whose motion was seen across their face", c.across_face);
     status.add("tracks whose motion was seen by the distance they walked", c.walked);
     status.add("new tracks whose box took their second cluster's axes", c.second_axes);
     status.add("boxes turned to a long cluster's axis", c.long_box);

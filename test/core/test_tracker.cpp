@@ -817,10 +817,9 @@ namespace {
 
 /// The first scan from which the track of a small object walking along x at @p speed (from x = -2, returns at
 /// y = 5.1 … 5.4, every 0.1 m over 0.4 m along x, or a single row at y = 5.3 with @p sliver) is moving, -1 if never
-/// within 2 s. A sliver shows its body in scan @p body_scan only (returns at y = 5.2 … 5.4: 0.2 m wide, less than
-/// its box grows by). Free space is seen up to y = 5.5 only (beyond: a facade's shadow), so that every cell of the
-/// object lies next to space not seen.
-int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver, int body_scan = -1)
+/// within 2 s. Free space is seen up to y = 5.5 only (beyond: a facade's shadow), so that every cell of the object
+/// lies next to space not seen.
+int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver)
 {
   Tracker tracker(params);
   for (int k = 0; k < 20; ++k)
@@ -829,9 +828,7 @@ int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver, in
     std::vector<Point2> points;
     for (int i = 0; i <= 12; ++i)
     {
-      if (sliver && k == body_scan && i <= 4)
-        for (const double y : { 5.2, 5.3, 5.4 }) points.push_back(Point2{ x0 + 0.1 * i, y });
-      else if (sliver && k != body_scan)
+      if (sliver)
         points.push_back(Point2{ x0 + 0.4 * i / 12.0, 5.3 });
       else if (i <= 4)
         for (const double y : { 5.1, 5.2, 5.3, 5.4 }) points.push_back(Point2{ x0 + 0.1 * i, y });
@@ -864,24 +861,6 @@ TEST(Tracker, SmallFreeSpaceLetsAPedestrianBesideAFacadeMove)
   TrackerParams any_extent = p;
   any_extent.free_space_small_min_extent = 0.0;
   EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), p.confirm_hits - 1) << "the sliver is moving without the least extent";
-}
-
-TEST(Tracker, WidestClusterLetsAWalkerSeenAsAColumnMove)
-{
-  // A walker seen from afar: its clusters are a single row (its box stays thinner than the least extent), but in
-  // one scan it shows a 0.4 × 0.2 m body.
-  TrackerParams p;
-  ASSERT_DOUBLE_EQ(p.free_space_small_widest, 0.15);
-  const int from = walkBesideAFacade(p, 1.4, true, 1);
-  EXPECT_GE(from, p.confirm_hits - 1) << "tentative before";
-  EXPECT_LE(from, 10) << "a walker at 1.4 m/s is moving within a second";
-  TrackerParams off = p;
-  off.free_space_small_widest = 0.0;
-  EXPECT_EQ(walkBesideAFacade(off, 1.4, true, 1), -1) << "the step off: its box alone decides, the general margin";
-  TrackerParams wider = p;
-  wider.free_space_small_widest = 0.25;
-  EXPECT_EQ(walkBesideAFacade(wider, 1.4, true, 1), -1) << "a body narrower than the widest cluster asked for";
-  EXPECT_EQ(walkBesideAFacade(p, 1.4, true), -1) << "a sliver that never shows a body";
 }
 
 namespace {
@@ -940,9 +919,6 @@ TEST(Tracker, FreeSpaceParametersAreValidatedByName)
       { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = 1e3; } },
       { "tracker_free_space_small_margin", [](TrackerParams& p) { p.free_space_small_margin = 0.6; } },
       { "tracker_free_space_small_min_extent", [](TrackerParams& p) { p.free_space_small_min_extent = -1.0; } },
-      { "tracker_free_space_small_widest", [](TrackerParams& p) { p.free_space_small_widest = -0.1; } },
-      { "tracker_free_space_small_widest", [](TrackerParams& p) { p.free_space_small_widest = 1e3; } },
-      { "tracker_free_space_small_widest", [](TrackerParams& p) { p.free_space_small_widest = std::nan(""); } },
       { "tracker_free_space_small_max_speed", [](TrackerParams& p) { p.free_space_small_max_speed = std::nan(""); } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
@@ -1845,105 +1821,6 @@ TEST(Tracker, CommonTurnNeedsAKnownSensorAndASignificantSlowTurn)
     for (std::size_t i = 0; i < with.tracks().size(); ++i)
       EXPECT_EQ(with.tracks()[i].motion, without.tracks()[i].motion) << c.what << ", track " << i;
   }
-}
-
-namespace {
-
-/// Step across its face, on a sensor that never sees free space: the first scan (-1: never within 2.5 s) from which
-/// the track of @p points_at(k) (the returns of scan k, none when empty) is moving, and the step's count.
-template <class PointsAt>
-int movingFromWithoutFreeSpace(const TrackerParams& params, PointsAt&& points_at, std::uint64_t* across = nullptr)
-{
-  Tracker tracker(params);
-  int from = -1;
-  for (int k = 0; k < 25; ++k)
-  {
-    const std::vector<float> xy = flatten(points_at(k));
-    const ScanMassGrid scan = scanGrid(xy, [](Point2) { return false; });
-    tracker.update(0.1 * k, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 }, nullptr, &scan);
-    EXPECT_LE(tracker.tracks().size(), 1u) << "scan " << k;
-    for (const Track& t : tracker.tracks())
-      if (t.motion == TrackMotion::kMoving && from < 0) from = k;
-  }
-  if (across) *across = tracker.counts().across_face;
-  return from;
-}
-
-/// Returns on a face 1.7 m long across x (a car's end seen end-on) at x, two rows 0.1 m apart, every 0.1 m.
-std::vector<Point2> endFace(double x)
-{
-  std::vector<Point2> out;
-  for (double y = -0.85; y <= 0.85 + 1e-9; y += 0.1)
-  {
-    out.push_back(Point2{ x, 5.0 + y });
-    out.push_back(Point2{ x + 0.1, 5.0 + y });
-  }
-  return out;
-}
-
-}  // namespace
-
-TEST(Tracker, AcrossFaceSeesACarEndOnWhoseRoadIsHidden)
-{
-  // A car followed end-on at 6 m/s beyond a lead car that hides the road around it: free space never shows it move.
-  const auto car = [](int k) { return endFace(10.0 + 0.6 * k); };
-  TrackerParams on;
-  ASSERT_TRUE(on.across_face);
-  std::uint64_t across = 0;
-  EXPECT_EQ(movingFromWithoutFreeSpace(on, car, &across), on.across_min_hits - 1)
-      << "moving at the scan of its across_min_hits-th consecutive association";
-  EXPECT_EQ(across, 1u);
-  TrackerParams off = on;
-  off.across_face = false;
-  EXPECT_EQ(movingFromWithoutFreeSpace(off, car, &across), -1) << "the free-space check alone never sees it move";
-  EXPECT_EQ(across, 0u);
-  TrackerParams fewer = on;
-  fewer.across_min_hits = 8;
-  EXPECT_EQ(movingFromWithoutFreeSpace(fewer, car), 7);
-  // Missing one scan in five, it is never associated in across_min_hits consecutive scans.
-  const auto hopping = [&](int k) { return k % 5 == 4 ? std::vector<Point2>{} : car(k); };
-  EXPECT_EQ(movingFromWithoutFreeSpace(on, hopping, &across), -1);
-  EXPECT_EQ(across, 0u);
-}
-
-TEST(Tracker, AcrossFaceLeavesWhatMovesAlongItselfOrIsNoFace)
-{
-  TrackerParams on;
-  std::uint64_t across = 0;
-  // The visible 4 m of a wall along x, sliding along itself at 6 m/s as the view changes.
-  const auto wall = [](int k) {
-    std::vector<Point2> out;
-    for (double u = 0.0; u <= 4.0 + 1e-9; u += 0.1)
-    {
-      out.push_back(Point2{ 0.6 * k + u, 15.1 });
-      out.push_back(Point2{ 0.6 * k + u, 15.2 });
-    }
-    return out;
-  };
-  EXPECT_EQ(movingFromWithoutFreeSpace(on, wall, &across), -1);
-  EXPECT_EQ(across, 0u);
-  // A 4 × 2 m car's outline (no face: its width is half its length) moving at 6 m/s across its length.
-  const auto box = [](int k) { return boxOutline(5.0, -10.0 + 0.6 * k, 0.0, 4.0, 2.0); };
-  EXPECT_EQ(movingFromWithoutFreeSpace(on, box, &across), -1);
-  EXPECT_EQ(across, 0u);
-  TrackerParams any_width = on;
-  any_width.across_max_width_share = 1.0;
-  EXPECT_EQ(movingFromWithoutFreeSpace(any_width, box, &across), on.across_min_hits - 1) << "as a face, it would move";
-  // A face that does not move.
-  EXPECT_EQ(movingFromWithoutFreeSpace(on, [](int) { return endFace(10.0); }, &across), -1);
-  EXPECT_EQ(across, 0u);
-}
-
-TEST(Tracker, AcrossFaceParametersAreValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_across_min_hits", [](TrackerParams& p) { p.across_min_hits = 0; } },
-      { "tracker_across_min_length", [](TrackerParams& p) { p.across_min_length = -0.1; } },
-      { "tracker_across_min_length", [](TrackerParams& p) { p.across_min_length = std::nan(""); } },
-      { "tracker_across_max_width_share", [](TrackerParams& p) { p.across_max_width_share = 0.0; } },
-      { "tracker_across_max_width_share", [](TrackerParams& p) { p.across_max_width_share = 1.5; } },
-      { "tracker_across_sigmas", [](TrackerParams& p) { p.across_sigmas = -1.0; } },
-      { "tracker_across_sigmas", [](TrackerParams& p) { p.across_sigmas = 11.0; } } });
 }
 
 namespace {

@@ -114,13 +114,10 @@ struct TrackerParams
   /// free_space_margin of it, so that free space never shows where it left or came. A track at most
   /// free_space_small_size long and wide (0: off), at least free_space_small_min_extent on both axes (a sliver of a
   /// wall seen edge-on is thinner) and no faster than free_space_small_max_speed (a walk) is checked with
-  /// free_space_small_margin instead. Step "widest cluster": a track whose box stays thinner (a walker seen from
-  /// afar, where its returns are a column) also counts as thick enough once one of its clusters was at least
-  /// free_space_small_widest long and wide (Track::widest_length, widest_width; 0: off).
+  /// free_space_small_margin instead.
   double free_space_small_size = 1.0;        ///< m
   double free_space_small_margin = 0.0;      ///< m, [0, free_space_margin]
   double free_space_small_min_extent = 0.1;  ///< m
-  double free_space_small_widest = 0.15;     ///< m
   double free_space_small_max_speed = 2.0;   ///< m/s
   /// Step "heading box": a track's box keeps the axes of its first cluster, so an object that turns is seen askew in
   /// them: its box grows (a cyclist's to 1.7 × 1.6 m) and the point followed slides off the object until the gate
@@ -212,18 +209,6 @@ struct TrackerParams
   /// {C, N, S, V}), so the cells of a moving track's returns, and the box cells of a small mover (step small movers),
   /// also move to V the sets holding C or N. With a prior, C and N are the map's and the counter's and stay.
   bool evidence_without_map = true;
-  /// Step "across its face" (free-space check): a static structure seen from a moving sensor can seem to move, but only
-  /// along itself (the visible part of a wall or a fence slides as the view changes). A track associated in each of
-  /// its last across_min_hits scans, whose cluster this scan is a face (at least across_min_length long, its width at
-  /// most across_max_width_share of that) and whose velocity across that face, relative to the common motion, clears
-  /// moving_speed by across_sigmas σ has shown its motion as the free-space check would (Track::motion_seen): a car
-  /// seen end-on beyond the car ahead, whose road the lead car hides. A track hopping from one parked car's end to the
-  /// next as the sensor passes a row of them also seems to move across their faces, but it misses scans while it hops.
-  bool across_face = true;
-  int across_min_hits = 15;             ///< consecutive associations
-  double across_min_length = 1.0;       ///< m
-  double across_max_width_share = 0.3;  ///< (0, 1]
-  double across_sigmas = 3.0;
   /// Step "walked" (free-space check): a pedestrian on a pavement behind parked cars is hidden from the ground around
   /// it, so free space never shows where it left or came. A track checked as a small walker (step small free space)
   /// that was associated in each of its last walk_min_hits scans and whose position moved at least walk_distance,
@@ -321,7 +306,6 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_free_space_small_size", p.free_space_small_size, { "m", "step small free space: a track at most this long and wide is checked with tracker_free_space_small_margin; 0: off" });
   get("tracker_free_space_small_margin", p.free_space_small_margin, { "m", "the free-space margin of a small track (step small free space)" });
   get("tracker_free_space_small_min_extent", p.free_space_small_min_extent, { "m", "… when at least this long and wide (a sliver of a wall is thinner)" });
-  get("tracker_free_space_small_widest", p.free_space_small_widest, { "m", "step widest cluster: … or when one of its clusters was at least this long and wide (a walker seen as a column from afar); 0: off" });
   get("tracker_free_space_small_max_speed", p.free_space_small_max_speed, { "m/s", "… and no faster than this (a walk)" });
   get("tracker_heading_box", p.heading_box, { "", "step heading box: a short moving track's box turns to its heading once askew" });
   get("tracker_heading_box_angle", p.heading_box_angle, { "deg", "the box turns when its axes are this far from the track's heading" });
@@ -348,11 +332,6 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_common_motion_max_turn_rate", p.common_motion_max_turn_rate, { "rad/s", "a faster common turn is not a drift: the median stays" });
   get("tracker_evidence_small_specialised", p.evidence_small_specialised, { "", "step small specialised: a small mover's cells also move their mass on {N}, {S}, {N, S} to V (the counter's specialisation of a walker's pavement cells)" });
   get("tracker_evidence_without_map", p.evidence_without_map, { "", "step movers without a map: without a prior a moving track's return cells (and a small mover's box) also move the sets holding C or N to V" });
-  get("tracker_across_face", p.across_face, { "", "step across its face: a track moving across its cluster's face (a car seen end-on) has shown its motion as the free-space check would" });
-  get("tracker_across_min_hits", p.across_min_hits, { "scans", "consecutive associations a track needs before step across its face" });
-  get("tracker_across_min_length", p.across_min_length, { "m", "shortest cluster that is a face" });
-  get("tracker_across_max_width_share", p.across_max_width_share, { "", "largest width of a face, as a share of its length" });
-  get("tracker_across_sigmas", p.across_sigmas, { "", "standard deviations by which the speed across the face must clear tracker_moving_speed" });
   get("tracker_walked", p.walked, { "", "step walked: a small walker seen in each of its last tracker_walk_min_hits scans that moved tracker_walk_distance since its oldest sighting has shown its motion as free space would" });
   get("tracker_walk_min_hits", p.walk_min_hits, { "scans", "consecutive associations a track needs before step walked" });
   get("tracker_walk_distance", p.walk_distance, { "m", "how far a small walker must have moved since its oldest sighting (step walked)" });
@@ -476,7 +455,6 @@ struct Track
   Eigen::Vector4d x = Eigen::Vector4d::Zero();
   Eigen::Matrix4d P = Eigen::Matrix4d::Identity();
   double yaw = 0.0, length = 0.0, width = 0.0;  ///< of the last associated cluster
-  double widest_length = 0.0, widest_width = 0.0;  ///< m, the largest length and width of its clusters so far
   /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
   double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;
   /// Measurements of the last scan (Tracker::measurements()) that are pieces of its object besides its own: with step
@@ -537,7 +515,6 @@ struct TrackerCounts
   std::uint64_t duplicates = 0;         ///< moving tracks deleted as duplicates of another (step duplicates)
   std::uint64_t common_motion_scans = 0;  ///< scans with a common motion (step common motion)
   std::uint64_t common_turn_scans = 0;    ///< scans whose common motion turns (step common turn)
-  std::uint64_t across_face = 0;  ///< tracks whose motion was seen across their face (step across its face)
   std::uint64_t walked = 0;       ///< tracks whose motion was seen by the distance they walked (step walked)
   std::uint64_t split_measurements = 0;  ///< measurements that are pieces of a cluster too large (step background split)
   std::uint64_t second_axes = 0;  ///< new tracks whose box turned to their second cluster's axes (step second axes)
@@ -665,8 +642,6 @@ private:
   bool fastEnough(const Track& t, double sigmas) const;
   /// Step small free space: @p t is checked with free_space_small_margin.
   bool smallWalker(const Track& t) const;
-  /// Step across its face: @p t's cluster this scan is a face and its velocity across it is significant.
-  bool movesAcrossFace(const Track& t) const;
   /// Step duplicates: deletes from @p tracks the duplicates of moving tracks seen at @p stamp; their clusters become
   /// the kept tracks' fragments.
   void dropDuplicates(std::vector<Track>& tracks, double stamp);
