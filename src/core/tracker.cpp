@@ -29,6 +29,9 @@ constexpr int kMaxBound = 1000000;     // max_measurements, max_tracks: beyond a
 constexpr std::size_t kMaxExactComponent = 100;
 constexpr double kSymmetryTolerance = 1e-9;  // relative: a covariance's two off-diagonal terms differ by rounding only
 constexpr double kMaxBox = 1e6;  // m: a measurement's box beyond this (either way) is no object's: not used
+constexpr double kMaxManoeuvreSigma = 100.0;  // m/s³: the manoeuvring model's jerk noise, at most
+constexpr double kManoeuvreStartRate = 0.5;   // 1/s: quiet → manoeuvring (step manoeuvres; a manoeuvre every 2 s)
+constexpr double kManoeuvreEndRate = 2.0;     // 1/s: manoeuvring → quiet (a manoeuvre lasts 0.5 s on average)
 constexpr double kMinGateCell = 0.5;     // m: the association's grid cells are never smaller (max_gate_distance)
 constexpr double kGateSlack = 0.01;    // m added to the association's search radii (rounding)
 constexpr double kOpenEndsMaxAngle = 20.0 * M_PI / 180.0;  // rad: step open ends probes the cluster's own faces, so it
@@ -193,6 +196,7 @@ void TrackerParams::validate() const
   requirePositive("tracker_measurement_sigma", measurement_sigma);
   requireInRange("tracker_extent_sigma", extent_sigma, 0.0, 10.0);
   requirePositive("tracker_acceleration_sigma", acceleration_sigma);
+  requireInRange("tracker_manoeuvre_jerk_sigma", manoeuvre_jerk_sigma, 0.0, kMaxManoeuvreSigma);
   requirePositive("tracker_initial_speed_sigma", initial_speed_sigma);
   requirePositive("tracker_gate", gate);
   requirePositive("tracker_max_gate_distance", max_gate_distance);
@@ -467,7 +471,11 @@ ObjectBox objectBox(const Track& t, const TrackerParams& p, const std::vector<Me
   return b;
 }
 
-double Track::speedSigma() const { return core::speedSigma(x, P); }
+double Track::speedSigma() const
+{
+  if (!manoeuvres) return core::speedSigma(x, P);
+  return core::speedSigma(Eigen::Vector4d(imm.x[0].head<4>()), Eigen::Matrix4d(imm.P[0].topLeftCorner<4, 4>()));
+}
 
 Tracker::Tracker(const TrackerParams& params) : params_(params) { params_.validate(); }
 
@@ -488,7 +496,22 @@ void Tracker::reset()
   common_ = CommonMotion{};
 }
 
-void Tracker::predict(Track& t, double dt) const { predictConstantVelocity(t.x, t.P, dt, params_.acceleration_sigma); }
+ManoeuvreModel Tracker::manoeuvreModel() const
+{
+  return ManoeuvreModel{ params_.acceleration_sigma, params_.manoeuvre_jerk_sigma, kManoeuvreStartRate,
+                         kManoeuvreEndRate };
+}
+
+void Tracker::predict(Track& t, double dt) const
+{
+  if (!manoeuvres())
+  {
+    predictConstantVelocity(t.x, t.P, dt, params_.acceleration_sigma);
+    return;
+  }
+  predictImm(t.imm, dt, manoeuvreModel());
+  t.imm.combine(t.x, t.P);
+}
 
 namespace {
 
@@ -510,7 +533,14 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
 {
   bool long_box = false;
   const Point2 ref = referencePoint(t, m);
-  correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), measurementCovariance(t, m, params_));
+  if (manoeuvres())
+  {
+    correctImm(t.imm, Eigen::Vector2d(ref.x, ref.y), measurementCovariance(t, m, params_));
+    t.imm.combine(t.x, t.P);
+  }
+  else
+    correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), measurementCovariance(t, m, params_));
+  const Eigen::Vector2d corrected = t.x.head<2>();
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
@@ -549,6 +579,8 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
     t.extent_length = std::max(t.extent_length, m.length);
     t.extent_width = std::max(t.extent_width, m.width);
   }
+  // The box's bookkeeping moved the followed point on the object: every model follows it.
+  if (manoeuvres()) t.imm.shiftPosition(t.x.head<2>() - corrected);
   ++t.hits;
   ++t.consecutive_hits;
   if (background_known_) t.background_unchecked = false;
@@ -569,7 +601,7 @@ void Tracker::findCommonMotion(double stamp)
   common_seen_.clear();
   for (const Track& t : tracks_)
     if (t.reported() && t.last_hit >= stamp && finite(t.x, t.P))
-      common_seen_.push_back(SeenTrack{ t.position(), t.velocity(), t.speedSigma() });
+      common_seen_.push_back(SeenTrack{ t.position(), t.decisionVelocity(), t.speedSigma() });
   const auto sensor =
       std::find_if(measurements_.begin(), measurements_.end(), [](const Measurement& x) { return x.has_sensor; });
   const CommonMotionParams p{ params_.common_motion_min_tracks, params_.common_motion_share,
@@ -928,6 +960,9 @@ Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
   t.P.setZero();
   t.P.topLeftCorner<2, 2>() = z.covariance;
   t.P(2, 2) = t.P(3, 3) = params_.initial_speed_sigma * params_.initial_speed_sigma;
+  t.manoeuvres = manoeuvres();
+  if (t.manoeuvres)
+    t.imm.reset(t.x, t.P, params_.acceleration_sigma * params_.acceleration_sigma, manoeuvreModel().stationaryManoeuvre());
   t.yaw = t.extent_yaw = z.yaw;
   t.length = t.extent_length = z.length;
   t.width = t.extent_width = z.width;

@@ -28,6 +28,7 @@
 #include "map_aided_fusion/core/tracking/common_motion.hpp"
 #include "map_aided_fusion/core/tracking/lifecycle.hpp"
 #include "map_aided_fusion/core/tracking/motion_decision.hpp"
+#include "map_aided_fusion/core/tracking/motion_model.hpp"
 
 namespace map_aided_fusion {
 namespace core {
@@ -68,6 +69,10 @@ struct TrackerParams
   double measurement_sigma = 0.15;   ///< m, standard deviation of a compact cluster's centroid
   double extent_sigma = 0.1;         ///< m of standard deviation per metre of the cluster's extent on that axis
   double acceleration_sigma = 2.0;   ///< m/s², white-noise acceleration of the constant-velocity model
+  /// Step "manoeuvres" (core/tracking/motion_model.hpp, ImmState): the motion model is an interacting multiple model
+  /// of the constant-velocity model above and a constant-acceleration one with this white-noise jerk (m/s³), which
+  /// follows braking, pulling away and turning; 0: off, the constant-velocity model alone.
+  double manoeuvre_jerk_sigma = 5.0;
   double initial_speed_sigma = 5.0;  ///< m/s, velocity standard deviation of a new track
   double gate = 13.8;                ///< Mahalanobis² of an association (χ² with 2 dof: 13.8 is 99.9 %)
   double max_gate_distance = 3.0;    ///< m: no association farther than this, whatever the covariance
@@ -282,6 +287,7 @@ void forEachParam(TrackerParams& p, Get&& get)
   get("tracker_measurement_sigma", p.measurement_sigma, { "m", "standard deviation of a compact cluster's centroid" });
   get("tracker_extent_sigma", p.extent_sigma, { "m/m", "added standard deviation per metre of the cluster's extent on that axis" });
   get("tracker_acceleration_sigma", p.acceleration_sigma, { "m/s²", "white-noise acceleration of the constant-velocity model" });
+  get("tracker_manoeuvre_jerk_sigma", p.manoeuvre_jerk_sigma, { "m/s³", "step manoeuvres: white-noise jerk of the constant-acceleration model that an interacting multiple model mixes with the constant-velocity one (braking, turning); 0: off" });
   get("tracker_initial_speed_sigma", p.initial_speed_sigma, { "m/s", "velocity standard deviation of a new track" });
   get("tracker_gate", p.gate, { "", "Mahalanobis² gate of an association (χ², 2 dof: 13.8 is 99.9 %)" });
   get("tracker_max_gate_distance", p.max_gate_distance, { "m", "no association farther than this, whatever the covariance" });
@@ -446,7 +452,9 @@ struct SeenBox
   double length = 0.0, width = 0.0;  ///< m
 };
 
-/// A tracked object. State x = (x, y, vx, vy) in the map frame, covariance P.
+/// A tracked object. State x = (x, y, vx, vy) in the map frame, covariance P: what it reports. The motion decision
+/// reads the constant-velocity estimate instead (decisionVelocity(), speedSigma()): with step manoeuvres, the IMM's
+/// quiet model, whose velocity and σ a possible manoeuvre does not inflate; otherwise x and P themselves.
 struct Track
 {
   std::uint32_t id = 0;
@@ -454,6 +462,9 @@ struct Track
   TrackMotion motion = TrackMotion::kUnknown;
   Eigen::Vector4d x = Eigen::Vector4d::Zero();
   Eigen::Matrix4d P = Eigen::Matrix4d::Identity();
+  /// Step manoeuvres: the two models whose mixture x and P are (used when manoeuvres is set).
+  ImmState imm;
+  bool manoeuvres = false;
   double yaw = 0.0, length = 0.0, width = 0.0;  ///< of the last associated cluster
   /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
   double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;
@@ -478,9 +489,18 @@ struct Track
   Point2 position() const { return Point2{ x(0), x(1) }; }
   Point2 velocity() const { return Point2{ x(2), x(3) }; }
   double speed() const { return x.tail<2>().norm(); }
-  /// Speed relative to the velocity @p common (m/s, map frame).
-  double speedRelativeTo(Point2 common) const { return std::hypot(x(2) - common.x, x(3) - common.y); }
-  /// Standard deviation of the speed (along the velocity; the largest when the speed is near zero).
+  /// The velocity the motion decision tests (m/s, map frame): the constant-velocity estimate.
+  Point2 decisionVelocity() const
+  {
+    return manoeuvres ? Point2{ imm.x[0](2), imm.x[0](3) } : velocity();
+  }
+  /// Speed of decisionVelocity() relative to the velocity @p common (m/s, map frame).
+  double speedRelativeTo(Point2 common) const
+  {
+    const Point2 v = decisionVelocity();
+    return std::hypot(v.x - common.x, v.y - common.y);
+  }
+  /// Standard deviation of the speed of decisionVelocity() (along it; the largest when it is near zero).
   double speedSigma() const;
   /// Seconds since the first association.
   double age(double now) const { return now - first_stamp; }
@@ -620,6 +640,8 @@ public:
 private:
   void predict(Track& t, double dt) const;
   LifecycleParams lifecycleParams() const { return LifecycleParams{ params_.confirm_hits, params_.max_coast_time }; }
+  bool manoeuvres() const { return params_.manoeuvre_jerk_sigma > 0.0; }
+  ManoeuvreModel manoeuvreModel() const;
   /// Keeps the max_measurements of @p found nearest the sensor (counted); records the peak.
   void capMeasurements(std::vector<Measurement>& found);
   /// Predicted tracks × measurements_: the gated global assignment and the corrections; which measurements it used.
