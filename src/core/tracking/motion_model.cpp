@@ -10,6 +10,26 @@
 namespace map_aided_fusion {
 namespace core {
 
+namespace {
+
+/// The Kalman update of an N-dimensional state whose first two components are the position, measured as @p z with
+/// covariance @p r (H = [I, 0]), in Joseph form (it stays symmetric and positive semi-definite).
+template <int N>
+void correctPositionOf(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const Eigen::Vector2d& z,
+                       const Eigen::Matrix2d& r)
+{
+  const Eigen::Matrix2d s = P.template topLeftCorner<2, 2>() + r;
+  const Eigen::Matrix<double, N, 2> k = P.template leftCols<2>() * s.inverse();
+  const Eigen::Vector2d y(z.x() - x(0), z.y() - x(1));
+  x += k * y;
+  Eigen::Matrix<double, 2, N> h = Eigen::Matrix<double, 2, N>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  const Eigen::Matrix<double, N, N> ikh = Eigen::Matrix<double, N, N>::Identity() - k * h;
+  P = ikh * P * ikh.transpose() + k * r * k.transpose();
+}
+
+}  // namespace
+
 void predictConstantVelocity(Eigen::Vector4d& x, Eigen::Matrix4d& P, double dt, double acceleration_sigma)
 {
   Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
@@ -26,14 +46,7 @@ void predictConstantVelocity(Eigen::Vector4d& x, Eigen::Matrix4d& P, double dt, 
 
 void correctPosition(Eigen::Vector4d& x, Eigen::Matrix4d& P, const Eigen::Vector2d& z, const Eigen::Matrix2d& r)
 {
-  const Eigen::Matrix2d s = P.topLeftCorner<2, 2>() + r;
-  const Eigen::Matrix<double, 4, 2> k = P.leftCols<2>() * s.inverse();
-  const Eigen::Vector2d y(z.x() - x(0), z.y() - x(1));
-  x += k * y;
-  Eigen::Matrix<double, 2, 4> h = Eigen::Matrix<double, 2, 4>::Zero();
-  h(0, 0) = h(1, 1) = 1.0;
-  const Eigen::Matrix4d ikh = Eigen::Matrix4d::Identity() - k * h;
-  P = ikh * P * ikh.transpose() + k * r * k.transpose();
+  correctPositionOf<4>(x, P, z, r);
 }
 
 double velocitySigmaAlong(const Eigen::Matrix4d& P, const Eigen::Vector2d& direction)
@@ -94,14 +107,7 @@ void predictConstantAcceleration(ImmVector& x, ImmMatrix& P, double dt, double j
 
 void correctPosition(ImmVector& x, ImmMatrix& P, const Eigen::Vector2d& z, const Eigen::Matrix2d& r)
 {
-  const Eigen::Matrix2d s = P.topLeftCorner<2, 2>() + r;
-  const Eigen::Matrix<double, 6, 2> k = P.leftCols<2>() * s.inverse();
-  const Eigen::Vector2d y(z.x() - x(0), z.y() - x(1));
-  x += k * y;
-  Eigen::Matrix<double, 2, 6> h = Eigen::Matrix<double, 2, 6>::Zero();
-  h(0, 0) = h(1, 1) = 1.0;
-  const ImmMatrix ikh = ImmMatrix::Identity() - k * h;
-  P = ikh * P * ikh.transpose() + k * r * k.transpose();
+  correctPositionOf<6>(x, P, z, r);
 }
 
 void ImmState::reset(const Eigen::Vector4d& x0, const Eigen::Matrix4d& p0, double acceleration_variance,
