@@ -34,14 +34,10 @@ constexpr double kManoeuvreStartRate = 0.5;   // 1/s: quiet → manoeuvring (ste
 constexpr double kManoeuvreEndRate = 2.0;     // 1/s: manoeuvring → quiet (a manoeuvre lasts 0.5 s on average)
 constexpr double kMinGateCell = 0.5;     // m: the association's grid cells are never smaller (max_gate_distance)
 constexpr double kGateSlack = 0.01;    // m added to the association's search radii (rounding)
-constexpr double kOpenEndsMaxAngle = 20.0 * M_PI / 180.0;  // rad: step open ends probes the cluster's own faces, so it
-                                                            // decides along a box axis this near one of them only
 constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks the view (step open ends)
 constexpr double kOccluderGap = 1.0;   // m: an occluder lies at least this much nearer the sensor than an end it cuts
-constexpr double kAnchorTolerance = 0.3;  // m: a cluster this much shorter than the track's box is partly seen
 constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
 constexpr double kMaxHiddenEndsSigma = 100.0;  // m: hidden_ends_sigma, far beyond any object
-constexpr double kMinAxesTurn = 0.1;  // rad (about 6°): axes this near are the same (steps second axes, long box, far growth)
 constexpr double kLongBoxMaxWidthShare = 0.5;  // step long box: a cluster at most this wide for its length has an axis
 constexpr double kMaxLongBoxMinLength = 100.0;  // m: long_box_min_length, beyond any vehicle
 constexpr double kMinBoxFitStep = 0.1;   // deg: box_fit_step, 900 rectangles a cluster
@@ -55,6 +51,13 @@ const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
 
 bool finite(const Eigen::Vector4d& x, const Eigen::Matrix4d& p) { return x.allFinite() && p.allFinite(); }
 
+/// The measurement model's share of @p p.
+MeasurementModelParams measurementModelOf(const TrackerParams& p)
+{
+  return MeasurementModelParams{ p.measurement_sigma, p.extent_sigma, p.hidden_ends,
+                                 p.hidden_ends_sigma, p.open_anchor,  p.far_growth };
+}
+
 /// A measurement a track may take: finite, a symmetric positive definite covariance, a box no larger than kMaxBox.
 bool usable(const Measurement& m)
 {
@@ -66,18 +69,6 @@ bool usable(const Measurement& m)
          bounded(m.lo_v) && bounded(m.hi_v) && bounded(m.length) && bounded(m.width) &&
          (!m.has_sensor || (std::isfinite(m.sensor.x) && std::isfinite(m.sensor.y)));
 }
-
-/// Step hidden ends (TrackerParams::hidden_ends): @p m's two ends along its major axis are hidden and neither is open,
-/// and @p t is not yet moving.
-bool hiddenEnds(const Track& t, const Measurement& m, const TrackerParams& p)
-{
-  constexpr std::uint8_t kEnds = Measurement::kLowU | Measurement::kHighU;
-  return p.hidden_ends && t.motion != TrackMotion::kMoving && m.ends_seen && (m.occluded & kEnds) == kEnds &&
-         !(m.open & kEnds);
-}
-
-/// Standard deviation of a cluster's centroid along an axis on which it extends @p extent m.
-double clusterSigma(const TrackerParams& p, double extent) { return p.measurement_sigma + p.extent_sigma * extent; }
 
 /// The diagonal of the axis-aligned bounding box of @p points[@p idx] (m).
 double boxDiagonal(const std::vector<Point2>& points, const std::vector<int>& idx)
@@ -91,66 +82,6 @@ double boxDiagonal(const std::vector<Point2>& points, const std::vector<int>& id
     hy = std::max(hy, points[i].y);
   }
   return std::hypot(hx - lx, hy - ly);
-}
-
-/// The measurement of a cluster of returns @p idx with the rectangle @p box: its centroid, box and the centroid's
-/// covariance, clusterSigma() of its extent along each of the box's axes.
-Measurement measurementOf(const ClusterBox& box, std::vector<int>&& idx, const TrackerParams& p)
-{
-  const Eigen::Vector2d& major = box.major;
-  const Eigen::Vector2d minor(-major.y(), major.x());
-  Measurement m;
-  m.fitted = box.fitted;
-  m.length = box.length();
-  m.width = box.width();
-  m.centroid = Point2{ box.mean.x(), box.mean.y() };
-  m.lo_u = box.lo_u;
-  m.hi_u = box.hi_u;
-  m.lo_v = box.lo_v;
-  m.hi_v = box.hi_v;
-  m.yaw = std::atan2(major.y(), major.x());
-  m.points = static_cast<int>(idx.size());
-  const double su = clusterSigma(p, m.length), sv = clusterSigma(p, m.width);
-  Eigen::Matrix2d axes;
-  axes << major, minor;
-  m.covariance = axes * Eigen::Vector2d(su * su, sv * sv).asDiagonal() * axes.transpose();
-  m.returns = std::move(idx);
-  return m;
-}
-
-/// Step open anchor (TrackerParams::open_anchor): the end of @p m on which @p t's box is anchored along the cluster's
-/// major axis (viewAlong()) has free space beyond it.
-bool openAnchor(const Track& t, const Measurement& m, const TrackerParams& p)
-{
-  if (!p.open_anchor || !m.ends_seen || !m.has_sensor || !(t.extent_length > 0.0)) return false;
-  const AxisView a = viewAlong(m, Eigen::Vector2d(std::cos(m.yaw), std::sin(m.yaw)));
-  return (m.open & (a.anchor_lo ? Measurement::kLowU : Measurement::kHighU)) != 0;
-}
-
-/// Step far growth (TrackerParams::far_growth): @p m is placed by its open anchoring end (@p open, openAnchor()) and
-/// its major axis is one of @p t's box axes.
-bool farGrowth(const Track& t, const Measurement& m, const TrackerParams& p, bool open)
-{
-  return open && p.far_growth && std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) <= kMinAxesTurn;
-}
-
-/// The measurement's covariance, grown by the change of the cluster's extent since the track's last cluster: a
-/// partially seen object's centroid is off by up to half the part not seen; with step hidden ends, by
-/// hidden_ends_sigma along the major axis of a cluster whose ends are hidden. With step open anchor, a cluster placed
-/// by its open end has measurement_sigma along its major axis instead of its own σ; with step far growth, not grown.
-Eigen::Matrix2d measurementCovariance(const Track& t, const Measurement& m, const TrackerParams& p)
-{
-  const double dl = 0.5 * std::abs(m.length - t.length), dw = 0.5 * std::abs(m.width - t.width);
-  const Eigen::Vector2d major(std::cos(m.yaw), std::sin(m.yaw)), minor(-major.y(), major.x());
-  const bool open = openAnchor(t, m, p);
-  const double along = (farGrowth(t, m, p, open) ? 0.0 : dl * dl) +
-                       (hiddenEnds(t, m, p) ? p.hidden_ends_sigma * p.hidden_ends_sigma : 0.0);
-  if (open)
-  {
-    const double su = p.measurement_sigma, sv = clusterSigma(p, m.width);
-    return (su * su + along) * major * major.transpose() + (sv * sv + dw * dw) * minor * minor.transpose();
-  }
-  return m.covariance + along * major * major.transpose() + dw * dw * minor * minor.transpose();
 }
 
 }  // namespace
@@ -283,7 +214,7 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
     }
     if (on_background_mostly) continue;
     const int first = idx.front();  // in point order: the smallest
-    ordered.emplace_back(first, measurementOf(box, std::move(idx), p));
+    ordered.emplace_back(first, measurementOf(box, std::move(idx), measurementModelOf(p)));
   }
   if (split.size() >= static_cast<std::size_t>(p.min_cluster_points))
   {
@@ -305,35 +236,6 @@ std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const
   out.reserve(ordered.size());
   for (const std::size_t k : order) out.push_back(std::move(ordered[k].second));
   return out;
-}
-
-AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis)
-{
-  const Eigen::Vector2d mu(std::cos(m.yaw), std::sin(m.yaw)), mv(-mu.y(), mu.x());
-  AxisView a{ 1e300, -1e300, true };
-  for (double u : { m.lo_u, m.hi_u })
-    for (double v : { m.lo_v, m.hi_v })
-    {
-      const double x = (u * mu + v * mv).dot(axis);
-      a.lo = std::min(a.lo, x);
-      a.hi = std::max(a.hi, x);
-    }
-  const Eigen::Vector2d sensor(m.sensor.x - m.centroid.x, m.sensor.y - m.centroid.y);
-  const bool near_lo = sensor.dot(axis) < 0.5 * (a.lo + a.hi);
-  a.anchor_lo = near_lo;
-  if (m.ends_seen)
-  {
-    const double du = mu.dot(axis), dv = mv.dot(axis);
-    const bool major = std::abs(du) >= std::abs(dv);
-    if (std::max(std::abs(du), std::abs(dv)) < std::cos(kOpenEndsMaxAngle)) return a;
-    const double d = major ? du : dv;
-    const std::uint8_t low = major ? Measurement::kLowU : Measurement::kLowV;
-    const std::uint8_t high = major ? Measurement::kHighU : Measurement::kHighV;
-    const std::uint8_t lo_bit = d > 0.0 ? low : high, hi_bit = d > 0.0 ? high : low;
-    const std::uint8_t near_bit = near_lo ? lo_bit : hi_bit, far_bit = near_lo ? hi_bit : lo_bit;
-    if ((m.occluded & near_bit) && (m.open & far_bit)) a.anchor_lo = !near_lo;
-  }
-  return a;
 }
 
 bool hiddenFromSensor(const ScanMassGrid& scan, const Pose2& pose, Point2 p, double gap)
@@ -373,11 +275,6 @@ void findOpenEnds(Measurement& m, const SeenFree& free, const ScanMassGrid& scan
 
 namespace {
 
-bool anchored(const Track& t, const Measurement& m)
-{
-  return m.has_sensor && t.extent_length > 0.0 && m.hi_u - m.lo_u > 0.0;
-}
-
 /// Step second axes (TrackerParams::second_axes): turns the box of @p t, seen once, to the axes of its second cluster
 /// @p m when the first had none and @p m has. True when it turned.
 bool takeSecondAxes(Track& t, const Measurement& m, const TrackerParams& p)
@@ -396,25 +293,14 @@ bool takeSecondAxes(Track& t, const Measurement& m, const TrackerParams& p)
   return true;
 }
 
-/// Offset of the track's box centre from the centroid along one axis: the middle of the cluster when it is as long as
-/// the box, else the box placed on the cluster's anchoring end (viewAlong()).
-double centreAlong(const AxisView& a, double extent)
-{
-  if (std::abs((a.hi - a.lo) - extent) <= kAnchorTolerance) return 0.5 * (a.lo + a.hi);
-  return a.anchor_lo ? a.lo + 0.5 * extent : a.hi - 0.5 * extent;
-}
-
 }  // namespace
 
-Point2 referencePoint(const Track& t, const Measurement& m)
+TrackView trackView(const Track& t)
 {
-  if (!anchored(t, m)) return m.centroid;
-  const Eigen::Vector2d tu(std::cos(t.extent_yaw), std::sin(t.extent_yaw)), tv(-tu.y(), tu.x());
-  const Eigen::Vector2d r = Eigen::Vector2d(m.centroid.x, m.centroid.y) +
-                            centreAlong(viewAlong(m, tu), t.extent_length) * tu +
-                            centreAlong(viewAlong(m, tv), t.extent_width) * tv;
-  return Point2{ r.x(), r.y() };
+  return TrackView{ t.extent_yaw, t.extent_length, t.extent_width, t.length, t.width, t.motion == TrackMotion::kMoving };
 }
+
+Point2 referencePoint(const Track& t, const Measurement& m) { return anchorPoint(trackView(t), m); }
 
 ObjectBox ownBox(const Track& t) { return ObjectBox{ t.position(), t.extent_yaw, t.extent_length, t.extent_width }; }
 
@@ -535,16 +421,16 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   const Point2 ref = referencePoint(t, m);
   if (manoeuvres())
   {
-    correctImm(t.imm, Eigen::Vector2d(ref.x, ref.y), measurementCovariance(t, m, params_));
+    correctImm(t.imm, Eigen::Vector2d(ref.x, ref.y), anchorCovariance(trackView(t), m, measurementModelOf(params_)));
     t.imm.combine(t.x, t.P);
   }
   else
-    correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), measurementCovariance(t, m, params_));
+    correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), anchorCovariance(trackView(t), m, measurementModelOf(params_)));
   const Eigen::Vector2d corrected = t.x.head<2>();
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
-  if (t.motion == TrackMotion::kMoving && anchored(t, m) && t.speed() > kTinySpeed)
+  if (t.motion == TrackMotion::kMoving && anchored(trackView(t), m) && t.speed() > kTinySpeed)
   {
     const double heading = std::atan2(t.x(3), t.x(2));
     const double max_off = params_.heading_box_angle * M_PI / 180.0;
@@ -560,7 +446,7 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
       long_box = true;
     }
   }
-  if (anchored(t, m))
+  if (anchored(trackView(t), m))
   {
     // A longer cluster than the box: the box grows away from its anchoring end; its centre moves, the object does not.
     const Eigen::Vector2d tu(std::cos(t.extent_yaw), std::sin(t.extent_yaw)), tv(-tu.y(), tu.x());
@@ -891,10 +777,10 @@ std::vector<char> Tracker::associate(double stamp)
     {
       const Measurement& z = measurements_[pairs[r]];
       if (takeSecondAxes(t, z, params_)) ++counts_.second_axes;
-      if (hiddenEnds(t, z, params_)) ++counts_.hidden_ends;
-      const bool open = openAnchor(t, z, params_);
+      if (hiddenEnds(trackView(t), z, measurementModelOf(params_))) ++counts_.hidden_ends;
+      const bool open = openAnchor(trackView(t), z, measurementModelOf(params_));
       counts_.open_anchor += open;
-      counts_.far_growth += farGrowth(t, z, params_, open);
+      counts_.far_growth += farGrowth(trackView(t), z, measurementModelOf(params_), open);
       if (correct(t, z, stamp)) ++counts_.long_box;
       used[pairs[r]] = 1;
       t.measurement = pairs[r];
@@ -1009,7 +895,7 @@ std::optional<double> Tracker::gateCost(const Track& t, const Measurement& z) co
   const Point2 ref = referencePoint(t, z);
   const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
   if (y.norm() > params_.max_gate_distance) return std::nullopt;  // before the covariance: most pairs end here
-  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + measurementCovariance(t, z, params_);
+  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + anchorCovariance(trackView(t), z, measurementModelOf(params_));
   return mahalanobisGate(y, s, params_.max_gate_distance, params_.gate);
 }
 

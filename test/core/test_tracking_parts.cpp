@@ -14,6 +14,7 @@
 #include "map_aided_fusion/core/tracking/clustering.hpp"
 #include "map_aided_fusion/core/tracking/common_motion.hpp"
 #include "map_aided_fusion/core/tracking/lifecycle.hpp"
+#include "map_aided_fusion/core/tracking/measurement_model.hpp"
 #include "map_aided_fusion/core/tracking/motion_decision.hpp"
 #include "map_aided_fusion/core/tracking/motion_model.hpp"
 #include "map_aided_fusion/core/tracking/shape_fit.hpp"
@@ -561,6 +562,105 @@ TEST(CommonMotion, TooFewTracksTrafficOrAMixIsNoCommonMotion)
   EXPECT_FALSE(none.found);
   EXPECT_EQ(none.velocity.x, 0.0);
   EXPECT_EQ(none.turn_rate, 0.0);
+}
+
+TEST(MeasurementModel, AClusterCovarianceHasItsExtentGrownSigmaAlongEachBoxAxis)
+{
+  ClusterBox box;
+  box.mean = Eigen::Vector2d(1.0, 2.0);
+  box.major = Eigen::Vector2d(std::cos(0.5), std::sin(0.5));
+  box.lo_u = -2.0;
+  box.hi_u = 2.0;
+  box.lo_v = -0.9;
+  box.hi_v = 0.9;
+  const MeasurementModelParams p;  // 0.15 m + 0.1 m per metre
+  const Measurement m = measurementOf(box, { 4, 5, 6 }, p);
+  EXPECT_EQ(m.points, 3);
+  EXPECT_DOUBLE_EQ(m.length, 4.0);
+  EXPECT_DOUBLE_EQ(m.width, 1.8);
+  EXPECT_NEAR(m.yaw, 0.5, 1e-15);
+  const Eigen::Vector2d minor(-box.major.y(), box.major.x());
+  const double su = 0.15 + 0.1 * 4.0, sv = 0.15 + 0.1 * 1.8;
+  EXPECT_LT((m.covariance * box.major - su * su * box.major).norm(), 1e-12);
+  EXPECT_LT((m.covariance * minor - sv * sv * minor).norm(), 1e-12);
+}
+
+/// A cluster centred at (10, 0) along x, @p length long and 1.8 m wide, seen from the origin.
+Measurement clusterAlongX(double length)
+{
+  Measurement m;
+  m.centroid = Point2{ 10.0, 0.0 };
+  m.yaw = 0.0;
+  m.length = length;
+  m.width = 1.8;
+  m.lo_u = -0.5 * length;
+  m.hi_u = 0.5 * length;
+  m.lo_v = -0.9;
+  m.hi_v = 0.9;
+  const double su = 0.15 + 0.1 * length, sv = 0.15 + 0.1 * 1.8;
+  m.covariance = Eigen::Vector2d(su * su, sv * sv).asDiagonal();
+  m.has_sensor = true;
+  m.sensor = Point2{ 0.0, 0.0 };
+  return m;
+}
+
+TEST(MeasurementModel, TheAnchorIsTheBoxPlacedOnTheClustersAnchoringEnd)
+{
+  const TrackView car{ 0.0, 4.0, 1.8, 4.0, 1.8, false };  // a 4 × 1.8 m box along x
+  // Its rear metre seen: the box placed on the end nearest the sensor (x = 9.5), its centre 2 m beyond.
+  const Measurement rear = clusterAlongX(1.0);
+  EXPECT_NEAR(anchorPoint(car, rear).x, 9.5 + 2.0, 1e-12);
+  EXPECT_NEAR(anchorPoint(car, rear).y, 0.0, 1e-12);
+  // Seen whole (within kAnchorTolerance): the middle of the cluster.
+  EXPECT_NEAR(anchorPoint(car, clusterAlongX(3.8)).x, 10.0, 1e-12);
+  // Its near end cut by an occluder and free space beyond its far end: placed on the far end (x = 10.5).
+  Measurement cut = rear;
+  cut.ends_seen = true;
+  cut.occluded = Measurement::kLowU;
+  cut.open = Measurement::kHighU;
+  EXPECT_NEAR(anchorPoint(car, cut).x, 10.5 - 2.0, 1e-12);
+  // Without the sensor, or a box: the centroid.
+  Measurement blind = rear;
+  blind.has_sensor = false;
+  EXPECT_EQ(anchorPoint(car, blind).x, 10.0);
+  EXPECT_EQ(anchorPoint(TrackView{}, rear).x, 10.0);
+}
+
+TEST(MeasurementModel, TheAnchorCovarianceGrowsWithTheChangeOfExtentAndTheHiddenOrOpenEnds)
+{
+  const MeasurementModelParams p;
+  const TrackView car{ 0.0, 4.0, 1.8, 4.0, 1.8, false };
+  const Measurement whole = clusterAlongX(4.0);
+  EXPECT_EQ(anchorCovariance(car, whole, p), whole.covariance) << "the same extents: the cluster's own";
+  // 2 m shorter than the last cluster: half of it, 1 m, of σ added along the major axis.
+  const Measurement shorter = clusterAlongX(2.0);
+  Eigen::Matrix2d expected = shorter.covariance;
+  expected(0, 0) += 1.0;
+  EXPECT_LT((anchorCovariance(car, shorter, p) - expected).norm(), 1e-12);
+  // Both ends hidden, neither open: hidden_ends_sigma along the axis, for a track not yet moving only.
+  Measurement gap = whole;
+  gap.ends_seen = true;
+  gap.occluded = Measurement::kLowU | Measurement::kHighU;
+  EXPECT_TRUE(hiddenEnds(car, gap, p));
+  expected = whole.covariance;
+  expected(0, 0) += p.hidden_ends_sigma * p.hidden_ends_sigma;
+  EXPECT_LT((anchorCovariance(car, gap, p) - expected).norm(), 1e-12);
+  TrackView moving = car;
+  moving.moving = true;
+  EXPECT_FALSE(hiddenEnds(moving, gap, p));
+  EXPECT_EQ(anchorCovariance(moving, gap, p), whole.covariance);
+  // Its anchoring (near) end open, along the box's axes: a compact cluster's σ along the axis, no growth (far growth).
+  Measurement open = shorter;
+  open.ends_seen = true;
+  open.open = Measurement::kLowU;
+  EXPECT_TRUE(openAnchor(car, open, p));
+  EXPECT_TRUE(farGrowth(car, open, p, true));
+  const double sv = 0.15 + 0.1 * 1.8;
+  EXPECT_LT((anchorCovariance(car, open, p) - Eigen::Vector2d(0.15 * 0.15, sv * sv).asDiagonal().toDenseMatrix()).norm(),
+            1e-12);
+  MeasurementModelParams no_far = p;
+  no_far.far_growth = false;
+  EXPECT_NEAR(anchorCovariance(car, open, no_far)(0, 0), 0.15 * 0.15 + 1.0, 1e-12) << "the growth stays";
 }
 
 }  // namespace

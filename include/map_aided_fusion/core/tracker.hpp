@@ -27,6 +27,7 @@
 #include "map_aided_fusion/core/seen_free.hpp"
 #include "map_aided_fusion/core/tracking/common_motion.hpp"
 #include "map_aided_fusion/core/tracking/lifecycle.hpp"
+#include "map_aided_fusion/core/tracking/measurement_model.hpp"
 #include "map_aided_fusion/core/tracking/motion_decision.hpp"
 #include "map_aided_fusion/core/tracking/motion_model.hpp"
 
@@ -374,44 +375,6 @@ void backgroundFlags(const Pose2& pose, const ObstaclePoints& returns, OnBackgro
   }
 }
 
-/// One object seen in one scan: a cluster of obstacle returns (map frame).
-struct Measurement
-{
-  Point2 centroid;
-  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();  ///< of the centroid, m²
-  double yaw = 0.0;     ///< rad, the cluster's major axis
-  double length = 0.0;  ///< m, extent along the major axis
-  double width = 0.0;   ///< m, extent along the minor axis
-  /// The cluster's box relative to the centroid: [lo_u, hi_u] along the major axis, [lo_v, hi_v] along the minor.
-  double lo_u = 0.0, hi_u = 0.0, lo_v = 0.0, hi_v = 0.0;
-  int points = 0;
-  bool has_sensor = false;  ///< the sensor position is known (the end of a partly seen object nearest it is real)
-  Point2 sensor;            ///< map frame
-  /// Step open ends, when ends_seen: the faces of the box (kLowU … kHighV) with free space beyond them, and those the
-  /// sensor cannot see past because a nearer obstacle blocks its line of sight.
-  std::uint8_t open = 0, occluded = 0;
-  bool ends_seen = false;
-  static constexpr std::uint8_t kLowU = 1, kHighU = 2, kLowV = 4, kHighV = 8;
-  std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
-  bool split = false;  ///< step background split: a piece of the returns off background of a cluster too large
-  bool fitted = false;  ///< step box fit: its axes are more than box_fit_step off its principal axes
-};
-
-/// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
-/// object's end, on which a longer box is anchored.
-struct AxisView
-{
-  double lo = 0.0, hi = 0.0;
-  bool anchor_lo = true;
-};
-
-/**
- * @brief The box of @p m (its four corners) seen along the unit vector @p axis (map frame). It is anchored on its end
- *        nearest the sensor, unless (Measurement::ends_seen, step open ends, along an axis within 20° of one of the
- *        cluster's) that end is occluded and the other open: then on the other.
- */
-AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis);
-
 /**
  * @brief Step open ends: the open and occluded faces of @p m's box, from one scan. A face is open when the point
  *        @p distance beyond its middle is clear in @p free, occluded when the line of sight from the vehicle at
@@ -558,6 +521,9 @@ struct TrackerCounts
  *        otherwise the middle of the cluster's extent. Without a sensor position, or a box, the centroid.
  */
 Point2 referencePoint(const Track& t, const Measurement& m);
+
+/// What the measurement model reads of @p t (measurement_model.hpp).
+TrackView trackView(const Track& t);
 
 /// What a track reports as its object (the tracks topic, the scoring of evaluate): centre, heading and extents.
 struct ObjectBox
