@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/LU>  // Matrix::determinant() (usable())
 
 #include "map_aided_fusion/core/assignment.hpp"
 #include "map_aided_fusion/core/parameters.hpp"
@@ -21,7 +21,6 @@ namespace {
 
 constexpr double kMinCellSize = 0.01;  // m
 constexpr double kMaxCellSize = 10.0;  // m
-constexpr double kTinySpeed = 1e-6;    // m/s: below, the speed's direction is undefined
 constexpr double kMinStep = 1e-6;      // s between two scans
 constexpr int kMaxBound = 1000000;     // max_measurements, max_tracks: beyond any scan, and memory
 /// Tracks or measurements of one gated component above which the association is greedy, not the cubic exact
@@ -363,7 +362,10 @@ double Track::speedSigma() const
   return core::speedSigma(Eigen::Vector4d(imm.x[0].head<4>()), Eigen::Matrix4d(imm.P[0].topLeftCorner<4, 4>()));
 }
 
-Tracker::Tracker(const TrackerParams& params) : params_(params) { params_.validate(); }
+Tracker::Tracker(const TrackerParams& params) : params_(params), measurement_model_(measurementModelOf(params))
+{
+  params_.validate();
+}
 
 std::size_t backgroundWarmupScans(double background_zeta, double delta_inc)
 {
@@ -419,18 +421,19 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
 {
   bool long_box = false;
   const Point2 ref = referencePoint(t, m);
+  const Eigen::Matrix2d r = anchorCovariance(trackView(t), m, measurement_model_);
   if (manoeuvres())
   {
-    correctImm(t.imm, Eigen::Vector2d(ref.x, ref.y), anchorCovariance(trackView(t), m, measurementModelOf(params_)));
+    correctImm(t.imm, Eigen::Vector2d(ref.x, ref.y), r);
     t.imm.combine(t.x, t.P);
   }
   else
-    correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), anchorCovariance(trackView(t), m, measurementModelOf(params_)));
+    correctPosition(t.x, t.P, Eigen::Vector2d(ref.x, ref.y), r);
   const Eigen::Vector2d corrected = t.x.head<2>();
   t.yaw = m.yaw;
   t.length = m.length;
   t.width = m.width;
-  if (t.motion == TrackMotion::kMoving && anchored(trackView(t), m) && t.speed() > kTinySpeed)
+  if (t.motion == TrackMotion::kMoving && anchored(trackView(t), m) && t.speed() > kDirectionlessSpeed)
   {
     const double heading = std::atan2(t.x(3), t.x(2));
     const double max_off = params_.heading_box_angle * M_PI / 180.0;
@@ -777,10 +780,11 @@ std::vector<char> Tracker::associate(double stamp)
     {
       const Measurement& z = measurements_[pairs[r]];
       if (takeSecondAxes(t, z, params_)) ++counts_.second_axes;
-      if (hiddenEnds(trackView(t), z, measurementModelOf(params_))) ++counts_.hidden_ends;
-      const bool open = openAnchor(trackView(t), z, measurementModelOf(params_));
+      const TrackView view = trackView(t);  // after step second axes turned its box
+      if (hiddenEnds(view, z, measurement_model_)) ++counts_.hidden_ends;
+      const bool open = openAnchor(view, z, measurement_model_);
       counts_.open_anchor += open;
-      counts_.far_growth += farGrowth(trackView(t), z, measurementModelOf(params_), open);
+      counts_.far_growth += farGrowth(view, z, measurement_model_, open);
       if (correct(t, z, stamp)) ++counts_.long_box;
       used[pairs[r]] = 1;
       t.measurement = pairs[r];
@@ -895,7 +899,7 @@ std::optional<double> Tracker::gateCost(const Track& t, const Measurement& z) co
   const Point2 ref = referencePoint(t, z);
   const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
   if (y.norm() > params_.max_gate_distance) return std::nullopt;  // before the covariance: most pairs end here
-  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + anchorCovariance(trackView(t), z, measurementModelOf(params_));
+  const Eigen::Matrix2d s = t.P.topLeftCorner<2, 2>() + anchorCovariance(trackView(t), z, measurement_model_);
   return mahalanobisGate(y, s, params_.max_gate_distance, params_.gate);
 }
 

@@ -639,6 +639,7 @@ private:
   void findCommonMotion(double stamp);
 
   TrackerParams params_;
+  MeasurementModelParams measurement_model_;  ///< params_' share for the measurement model (set once)
   std::vector<Track> tracks_;
   std::vector<Measurement> measurements_;
   std::vector<Measurement> own_measurements_;  ///< the last scan's clusters (update(stamp, pose, returns))
