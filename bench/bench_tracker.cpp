@@ -114,9 +114,9 @@ void BM_TrackerScan(benchmark::State& state)
   std::vector<ScanMassGrid> grids(kScenes);
   for (int k = 0; k < kScenes; ++k) scanScene(n, k, rng, xy[k], grids[k]);
   TrackerParams params;
-  params.free_space_check = state.range(1) != 0;
-  params.open_ends = state.range(2) != 0;
-  params.duplicates = state.range(3) != 0;
+  params.steps.free_space_check = state.range(1) != 0;
+  params.steps.open_ends = state.range(2) != 0;
+  params.steps.duplicates = state.range(3) != 0;
   Tracker tracker(params);
   int k = 0;
   for (auto _ : state)
@@ -202,7 +202,7 @@ void BM_SeenFree(benchmark::State& state)
   std::size_t clear = 0;
   for (auto _ : state)
   {
-    const SeenFree seen(scan, Pose2{}, 0.0, p.free_space_margin, p.free_space_small_margin);
+    const SeenFree seen(scan, Pose2{}, 0.0, p.free_space_margin, kSmallFreeSpaceMargin);
     clear = seen.clearCells();
     benchmark::DoNotOptimize(clear);
   }

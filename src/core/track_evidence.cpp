@@ -126,7 +126,7 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
 {
   std::vector<CellMotion> out;
   const TrackerParams& p = tracker.params();
-  if (!(p.evidence_weight > 0.0)) return out;
+  if (!p.steps.track_evidence || !(p.evidence_weight > 0.0)) return out;
   const std::vector<Point2>& points = tracker.points();
   const std::vector<Measurement>& measurements = tracker.measurements();
   for (const Track& t : tracker.tracks())
@@ -137,9 +137,9 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
                : t.motion == TrackMotion::kStopped ? CellClass::kStopped
                                                    : CellClass::kOccupied;
     c.weight = static_cast<float>(p.evidence_weight * motionProbability(t, p, tracker.commonMotionAt(t.position())));
-    c.take_n = c.motion == CellClass::kMoving && p.evidence_small_size > 0.0 &&
-               t.extent_length <= p.evidence_small_size && t.extent_width <= p.evidence_small_size;
-    c.take_specialised = c.take_n && p.evidence_small_specialised;
+    c.take_n = c.motion == CellClass::kMoving && p.steps.small_movers && t.extent_length <= p.pedestrian_size &&
+               t.extent_width <= p.pedestrian_size;
+    c.take_specialised = c.take_n && p.steps.small_specialised;
     const std::size_t first = out.size();
     auto addReturns = [&](int measurement) {
       if (measurement < 0 || measurement >= static_cast<int>(measurements.size())) return;
@@ -160,16 +160,16 @@ std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry
     out.erase(std::unique(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
                           [](const CellMotion& a, const CellMotion& b) { return a.cell == b.cell; }),
               out.end());
-    if (p.evidence_box && c.motion != CellClass::kOccupied)
+    if (p.steps.track_box && c.motion != CellClass::kOccupied)
     {
       const Measurement& m = measurements[t.measurement];
-      if (c.take_n && p.evidence_small_box)
-        addBoxInterior(smallMoverBox(m, p.evidence_small_size).value_or(m), g, c, first, out);
+      if (c.take_n && p.steps.small_box)
+        addBoxInterior(smallMoverBox(m, p.pedestrian_size).value_or(m), g, c, first, out);
       else if (c.motion == CellClass::kMoving && t.speed() > 0.0)
-        addBoxInterior(widened(hiddenLengthBox(m, heading(t), p.hidden_length ? p.evidence_hidden_length : 0.0,
-                                               p.evidence_end_width)
+        addBoxInterior(widened(hiddenLengthBox(m, heading(t), p.steps.hidden_length ? p.vehicle_length : 0.0,
+                                               kVehicleMinEndWidth)
                                    .value_or(m),
-                               p.evidence_box_margin),
+                               p.steps.box_margin ? kBoxMargin : 0.0),
                        g, c, first, out);
       else
         addBoxInterior(m, g, c, first, out);
@@ -192,18 +192,18 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
   const MapMassGrid& masses = grid.masses();
   const TrackerParams& p = tracker.params();
   const AlignedVector<float>& betp_c = grid.pignistic()[kBetPBuilding];
-  const bool building = p.building_background && betp_c.size() == g.numCells();
+  const bool building = p.steps.building_background && betp_c.size() == g.numCells();
   backgroundFlags(pose, returns,
                   [&](Point2 q) {
                     CellIndex c;
                     if (!g.worldToCell(q, c))
                     {
                       // Beyond the window: no counter, and the prior's own BetP(C) for the fused one.
-                      if (!p.building_background || !prior || !prior->geometry.worldToCell(q, c)) return false;
-                      return priorBetPBuilding(*prior, prior->geometry.index(c)) > p.background_building;
+                      if (!p.steps.building_background || !prior || !prior->geometry.worldToCell(q, c)) return false;
+                      return priorBetPBuilding(*prior, prior->geometry.index(c)) > kBuildingBackgroundBetP;
                     }
                     const std::size_t i = g.index(c);
-                    return masses.zeta(i) > p.background_zeta || (building && betp_c[i] > p.background_building);
+                    return masses.zeta(i) > p.background_zeta || (building && betp_c[i] > kBuildingBackgroundBetP);
                   },
                   background);
   // After a start or a reset ζ is 0 everywhere: a facade is no background until the counter has had its scans.
@@ -211,10 +211,10 @@ void trackScan(Tracker& tracker, MapGrid& grid, double stamp, const Pose2& pose,
                              backgroundWarmupScans(p.background_zeta, grid.params().fusion.counter.delta_inc));
   tracker.update(stamp, pose, returns, &background, scan);
   std::vector<CellMotion> cells = trackEvidence(tracker, g);
-  if (!prior && p.evidence_without_map)
+  if (!prior && p.steps.movers_without_map)
     for (CellMotion& c : cells)
       if (c.motion == CellClass::kMoving && (c.take_n || !c.interior)) c.take_n = c.take_c = true;
-  if (scan && tracker.params().evidence_box_hidden) markHidden(cells, g, *scan, pose);
+  if (scan && tracker.params().steps.box_hidden) markHidden(cells, g, *scan, pose);
   grid.applyTrackedMotion(cells);
 }
 

@@ -19,43 +19,22 @@ namespace core {
 
 namespace {
 
-constexpr double kMinCellSize = 0.01;  // m
-constexpr double kMaxCellSize = 10.0;  // m
 constexpr double kMinStep = 1e-6;      // s between two scans
-constexpr int kMaxBound = 1000000;     // max_measurements, max_tracks: beyond any scan, and memory
 /// Tracks or measurements of one gated component above which the association is greedy, not the cubic exact
 /// method (no component of any dataset comes near: a cluster of clutter where every object gates with the next).
 constexpr std::size_t kMaxExactComponent = 100;
 constexpr double kSymmetryTolerance = 1e-9;  // relative: a covariance's two off-diagonal terms differ by rounding only
 constexpr double kMaxBox = 1e6;  // m: a measurement's box beyond this (either way) is no object's: not used
-constexpr double kMaxManoeuvreSigma = 100.0;  // m/s³: the manoeuvring model's jerk noise, at most
 constexpr double kManoeuvreStartRate = 0.5;   // 1/s: quiet → manoeuvring (step manoeuvres; a manoeuvre every 2 s)
 constexpr double kManoeuvreEndRate = 2.0;     // 1/s: manoeuvring → quiet (a manoeuvre lasts 0.5 s on average)
 constexpr double kMinGateCell = 0.5;     // m: the association's grid cells are never smaller (max_gate_distance)
 constexpr double kGateSlack = 0.01;    // m added to the association's search radii (rounding)
-constexpr float kOccluderMass = 0.5f;  // m(O) of a ScanGrid cell that blocks the view (step open ends)
-constexpr double kOccluderGap = 1.0;   // m: an occluder lies at least this much nearer the sensor than an end it cuts
-constexpr double kMaxHeadingBoxAngle = 45.0;  // deg: the box's axes are never farther from a heading
-constexpr double kMaxHiddenEndsSigma = 100.0;  // m: hidden_ends_sigma, far beyond any object
 constexpr double kLongBoxMaxWidthShare = 0.5;  // step long box: a cluster at most this wide for its length has an axis
-constexpr double kMaxLongBoxMinLength = 100.0;  // m: long_box_min_length, beyond any vehicle
-constexpr double kMinBoxFitStep = 0.1;   // deg: box_fit_step, 900 rectangles a cluster
-constexpr double kMaxBoxFitStep = 45.0;  // deg: two rectangles, at 0° and 45°
-constexpr double kMaxBoxFitCloseness = 1.0;  // m: box_fit_closeness, beyond any object's edge
-constexpr double kMinShare = 1e-3;          // free_space_share: 0 would call everything seen
-constexpr double kMaxFreeSpaceTime = 10.0;  // s of ScanGrids kept (memory)
-constexpr double kMaxCommonTurnRate = 1.0;  // rad/s: common_motion_max_turn_rate, far beyond any drift
 // Step duplicates: pieces of one object move the same way, within 60°; two objects that pass each other do not.
 const double kDuplicateMinCosine = std::cos(M_PI / 3.0);
 
 bool finite(const Eigen::Vector4d& x, const Eigen::Matrix4d& p) { return x.allFinite() && p.allFinite(); }
 
-/// The measurement model's share of @p p.
-MeasurementModelParams measurementModelOf(const TrackerParams& p)
-{
-  return MeasurementModelParams{ p.measurement_sigma, p.extent_sigma, p.hidden_ends,
-                                 p.hidden_ends_sigma, p.open_anchor,  p.far_growth };
-}
 
 /// A measurement a track may take: finite, a symmetric positive definite covariance, a box no larger than kMaxBox.
 bool usable(const Measurement& m)
@@ -67,20 +46,6 @@ bool usable(const Measurement& m)
          std::isfinite(m.yaw) && bounded(m.lo_u) && bounded(m.hi_u) &&
          bounded(m.lo_v) && bounded(m.hi_v) && bounded(m.length) && bounded(m.width) &&
          (!m.has_sensor || (std::isfinite(m.sensor.x) && std::isfinite(m.sensor.y)));
-}
-
-/// The diagonal of the axis-aligned bounding box of @p points[@p idx] (m).
-double boxDiagonal(const std::vector<Point2>& points, const std::vector<int>& idx)
-{
-  double lx = 1e300, ly = 1e300, hx = -1e300, hy = -1e300;
-  for (int i : idx)
-  {
-    lx = std::min(lx, points[i].x);
-    ly = std::min(ly, points[i].y);
-    hx = std::max(hx, points[i].x);
-    hy = std::max(hy, points[i].y);
-  }
-  return std::hypot(hx - lx, hy - ly);
 }
 
 }  // namespace
@@ -112,175 +77,15 @@ std::vector<std::size_t> nearestFirst(At&& at, std::size_t n, std::size_t keep)
 
 }  // namespace
 
-void TrackerParams::validate() const
-{
-  requireInRange("tracker_cluster_distance", cluster_distance, 2.0 * kMinCellSize, 2.0 * kMaxCellSize);
-  requireInRange("tracker_min_cluster_points", min_cluster_points, 1, 1e6);
-  requireInRange("tracker_max_measurements", max_measurements, 1, kMaxBound);
-  requireInRange("tracker_max_tracks", max_tracks, 1, kMaxBound);
-  requireUnit("tracker_background_zeta", background_zeta);
-  requireUnit("tracker_background_share", background_share);
-  requireUnit("tracker_background_building", background_building);
-  requirePositive("tracker_max_object_length", max_object_length);
-  requirePositive("tracker_max_object_width", max_object_width);
-  requirePositive("tracker_measurement_sigma", measurement_sigma);
-  requireInRange("tracker_extent_sigma", extent_sigma, 0.0, 10.0);
-  requirePositive("tracker_acceleration_sigma", acceleration_sigma);
-  requireInRange("tracker_manoeuvre_jerk_sigma", manoeuvre_jerk_sigma, 0.0, kMaxManoeuvreSigma);
-  requirePositive("tracker_initial_speed_sigma", initial_speed_sigma);
-  requirePositive("tracker_gate", gate);
-  requirePositive("tracker_max_gate_distance", max_gate_distance);
-  requireInRange("tracker_confirm_hits", confirm_hits, 1, 1000);
-  requireInRange("tracker_fragment_margin", fragment_margin, 0.0, max_object_length);
-  requireInRange("tracker_open_end_distance", open_end_distance, 0.0, 10.0);
-  requireInRange("tracker_max_coast_time", max_coast_time, 0.0, 60.0);
-  requireInRange("tracker_moving_speed", moving_speed, 0.0, 100.0);
-  requireInRange("tracker_motion_sigmas", motion_sigmas, 0.0, 10.0);
-  requireInRange("tracker_stopped_speed", stopped_speed, 0.0, 100.0);
-  requireInRange("tracker_stopped_time", stopped_time, 0.0, 600.0);
-  requirePositive("tracker_max_speed", max_speed);
-  requirePositive("tracker_max_ego_speed", max_ego_speed);
-  requireUnit("tracker_evidence_weight", evidence_weight);
-  requireInRange("tracker_free_space_share", free_space_share, kMinShare, 1.0);
-  requireInRange("tracker_free_space_margin", free_space_margin, 0.0, kMaxCellSize);
-  requireInRange("tracker_free_space_time", free_space_time, kMinStep, kMaxFreeSpaceTime);
-  requireInRange("tracker_free_space_motion_sigmas", free_space_motion_sigmas, 0.0, 10.0);
-  requireInRange("tracker_free_space_small_size", free_space_small_size, 0.0, max_object_width);
-  requireInRange("tracker_free_space_small_margin", free_space_small_margin, 0.0, free_space_margin);
-  requireInRange("tracker_free_space_small_min_extent", free_space_small_min_extent, 0.0, max_object_width);
-  requireInRange("tracker_free_space_small_max_speed", free_space_small_max_speed, 0.0, max_speed);
-  requireInRange("tracker_evidence_hidden_length", evidence_hidden_length, 0.0, max_object_length);
-  requireInRange("tracker_evidence_end_width", evidence_end_width, 0.0, max_object_width);
-  requireInRange("tracker_evidence_box_margin", evidence_box_margin, 0.0, 0.5 * max_object_width);
-  requireInRange("tracker_evidence_small_size", evidence_small_size, 0.0, max_object_width);
-  requireInRange("tracker_heading_box_angle", heading_box_angle, 0.0, kMaxHeadingBoxAngle);
-  requireInRange("tracker_heading_box_max_length", heading_box_max_length, 0.0, max_object_length);
-  requireInRange("tracker_common_motion_min_tracks", common_motion_min_tracks, 1, 100000);
-  requireInRange("tracker_common_motion_share", common_motion_share, kMinShare, 1.0);
-  requireInRange("tracker_common_motion_sigmas", common_motion_sigmas, 0.0, 10.0);
-  requireInRange("tracker_common_motion_max_speed", common_motion_max_speed, 0.0, max_speed);
-  requireInRange("tracker_long_box_min_length", long_box_min_length, 0.0, kMaxLongBoxMinLength);
-  requireInRange("tracker_common_motion_max_turn_rate", common_motion_max_turn_rate, 0.0, kMaxCommonTurnRate);
-  requirePositive("tracker_background_split_size", background_split_size);
-  requireInRange("tracker_background_split_size", background_split_size, 0.0, max_object_width);
-  requireInRange("tracker_walk_min_hits", walk_min_hits, 1, 100000);
-  requirePositive("tracker_walk_distance", walk_distance);
-  requireInRange("tracker_walk_distance", walk_distance, 0.0, 10.0);
-  requireUnit("tracker_second_axes_round", second_axes_round);
-  requirePositive("tracker_second_axes_elongation", second_axes_elongation);
-  requireInRange("tracker_second_axes_elongation", second_axes_elongation, 0.0, 1.0);
-  requireInRange("tracker_second_axes_growth", second_axes_growth, 1.0, 100.0);
-  requirePositive("tracker_hidden_ends_sigma", hidden_ends_sigma);
-  requireInRange("tracker_hidden_ends_sigma", hidden_ends_sigma, 0.0, kMaxHiddenEndsSigma);
-  requireInRange("tracker_box_fit_step", box_fit_step, kMinBoxFitStep, kMaxBoxFitStep);
-  requirePositive("tracker_box_fit_closeness", box_fit_closeness);
-  requireInRange("tracker_box_fit_closeness", box_fit_closeness, 0.0, kMaxBoxFitCloseness);
-  requireInRange("tracker_box_fit_min_length", box_fit_min_length, 0.0, max_object_length);
-}
-
-std::vector<Measurement> clusterReturns(const std::vector<Point2>& points, const TrackerParams& p,
-                                        const std::vector<std::uint8_t>* background)
-{
-  std::vector<std::vector<int>> clusters = connectedClusters(points, 0.5 * p.cluster_distance);
-  std::vector<std::pair<int, Measurement>> ordered;  // by first cell, for a result independent of hashing
-  std::vector<int> split;  // step background split: the returns off background of the clusters too large
-  auto tooLarge = [&](const std::vector<int>& idx) {
-    if (!background || !p.background_split) return;
-    for (int i : idx)
-      if (!(*background)[i]) split.push_back(i);
-  };
-  // A cluster's extent along any axis is at most its bounding box's diagonal.
-  const double smallest_limit = std::min(p.max_object_length, p.max_object_width);
-  auto mayBeTooLarge = [&](const std::vector<int>& idx) { return boxDiagonal(points, idx) > smallest_limit; };
-  const BoxFitParams fit{ p.box_fit, p.box_fit_min_length, p.max_object_length, p.box_fit_step, p.box_fit_closeness };
-  for (std::vector<int>& idx : clusters)
-  {
-    if (static_cast<int>(idx.size()) < p.min_cluster_points) continue;
-    bool on_background_mostly = false;
-    if (background && p.background_share < 1.0)
-    {
-      std::size_t on_background = 0;
-      for (int i : idx) on_background += (*background)[i] != 0;
-      on_background_mostly = static_cast<double>(on_background) > p.background_share * static_cast<double>(idx.size());
-      // Step background split needs the extents of such a cluster only when it may be too large.
-      if (on_background_mostly && (!p.background_split || !mayBeTooLarge(idx))) continue;
-    }
-    const ClusterBox box = fitClusterBox(points, idx, fit);
-    if (box.length() > p.max_object_length || box.width() > p.max_object_width)
-    {
-      tooLarge(idx);
-      continue;
-    }
-    if (on_background_mostly) continue;
-    const int first = idx.front();  // in point order: the smallest
-    ordered.emplace_back(first, measurementOf(box, std::move(idx), measurementModelOf(p)));
-  }
-  if (split.size() >= static_cast<std::size_t>(p.min_cluster_points))
-  {
-    std::vector<Point2> sub(split.size());
-    for (std::size_t k = 0; k < split.size(); ++k) sub[k] = points[split[k]];
-    for (Measurement& m : clusterReturns(sub, p, nullptr))
-    {
-      if (m.length > p.background_split_size || m.width > p.background_split_size) continue;
-      m.split = true;
-      for (int& i : m.returns) i = split[i];
-      const int first = *std::min_element(m.returns.begin(), m.returns.end());
-      ordered.emplace_back(first, std::move(m));
-    }
-  }
-  std::vector<std::size_t> order(ordered.size());
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ordered[a].first < ordered[b].first; });
-  std::vector<Measurement> out;
-  out.reserve(ordered.size());
-  for (const std::size_t k : order) out.push_back(std::move(ordered[k].second));
-  return out;
-}
-
-bool hiddenFromSensor(const ScanMassGrid& scan, const Pose2& pose, Point2 p, double gap)
-{
-  const GridGeometry& g = scan.geometry();
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw), dx = p.x - pose.x, dy = p.y - pose.y;
-  const double vx = c * dx + s * dy, vy = -s * dx + c * dy, range = std::hypot(vx, vy), reach = range - gap;
-  if (!(reach > 0.0)) return false;
-  const float* occupied = scan.plane(FrameSG::kO);
-  const double step = 0.5 * g.resolution;
-  for (double r = step; r <= reach; r += step)
-  {
-    CellIndex cell;
-    if (!g.worldToCell(Point2{ vx * r / range, vy * r / range }, cell)) return false;
-    if (occupied[g.index(cell)] >= kOccluderMass) return true;
-  }
-  return false;
-}
-
-void findOpenEnds(Measurement& m, const SeenFree& free, const ScanMassGrid& scan, const Pose2& pose, double distance)
-{
-  const Eigen::Vector2d c(m.centroid.x, m.centroid.y), mu(std::cos(m.yaw), std::sin(m.yaw)), mv(-mu.y(), mu.x());
-  const double mid_u = 0.5 * (m.lo_u + m.hi_u), mid_v = 0.5 * (m.lo_v + m.hi_v);
-  m.open = m.occluded = 0;
-  auto probe = [&](double u, double v, std::uint8_t bit) {
-    const Eigen::Vector2d q = c + u * mu + v * mv;
-    const Point2 p{ q.x(), q.y() };
-    if (free.clear(p)) m.open |= bit;
-    if (hiddenFromSensor(scan, pose, p, distance + kOccluderGap)) m.occluded |= bit;
-  };
-  probe(m.lo_u - distance, mid_v, Measurement::kLowU);
-  probe(m.hi_u + distance, mid_v, Measurement::kHighU);
-  probe(mid_u, m.lo_v - distance, Measurement::kLowV);
-  probe(mid_u, m.hi_v + distance, Measurement::kHighV);
-  m.ends_seen = true;
-}
-
 namespace {
 
 /// Step second axes (TrackerParams::second_axes): turns the box of @p t, seen once, to the axes of its second cluster
 /// @p m when the first had none and @p m has. True when it turned.
 bool takeSecondAxes(Track& t, const Measurement& m, const TrackerParams& p)
 {
-  if (!p.second_axes || t.hits != 1) return false;
-  if (!(t.extent_width >= p.second_axes_round * t.extent_length)) return false;
-  if (!(m.width <= p.second_axes_elongation * m.length) || !(m.length > p.second_axes_growth * t.extent_length))
+  if (!p.steps.second_axes || t.hits != 1) return false;
+  if (!(t.extent_width >= kSecondAxesRound * t.extent_length)) return false;
+  if (!(m.width <= kSecondAxesElongation * m.length) || !(m.length > kSecondAxesGrowth * t.extent_length))
     return false;
   const double turn = std::remainder(m.yaw - t.extent_yaw, M_PI);
   if (!(std::abs(turn) > kMinAxesTurn)) return false;
@@ -328,7 +133,7 @@ std::optional<Measurement> hiddenLengthBox(const Measurement& m, double heading,
 ObjectBox objectBox(const Track& t, const TrackerParams& p, const std::vector<Measurement>& measurements)
 {
   ObjectBox b = ownBox(t);
-  if (!p.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0)) return b;
+  if (!p.steps.hidden_centre || t.motion != TrackMotion::kMoving || !(t.speed() > 0.0)) return b;
   if (t.measurement < 0)
   {
     if (!t.seen_box.valid) return b;
@@ -343,7 +148,7 @@ ObjectBox objectBox(const Track& t, const TrackerParams& p, const std::vector<Me
   if (t.measurement >= static_cast<int>(measurements.size())) return b;
   const Measurement& m = measurements[t.measurement];
   const std::optional<Measurement> e =
-      hiddenLengthBox(m, std::atan2(t.x(3), t.x(2)), p.evidence_hidden_length, p.evidence_end_width);
+      hiddenLengthBox(m, std::atan2(t.x(3), t.x(2)), p.vehicle_length, kVehicleMinEndWidth);
   if (!e) return b;
   const double cu = 0.5 * (e->lo_u + e->hi_u), cv = 0.5 * (e->lo_v + e->hi_v);
   const double c = std::cos(e->yaw), s = std::sin(e->yaw);
@@ -436,12 +241,12 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   if (t.motion == TrackMotion::kMoving && anchored(trackView(t), m) && t.speed() > kDirectionlessSpeed)
   {
     const double heading = std::atan2(t.x(3), t.x(2));
-    const double max_off = params_.heading_box_angle * M_PI / 180.0;
-    if (params_.heading_box && std::max(t.extent_length, t.extent_width) <= params_.heading_box_max_length)
+    const double max_off = kHeadingBoxAngleDeg * M_PI / 180.0;
+    if (params_.steps.heading_box && std::max(t.extent_length, t.extent_width) <= kHeadingBoxMaxLength)
     {
       if (std::abs(std::remainder(heading - t.extent_yaw, 0.5 * M_PI)) > max_off) turnBox(t, m, heading);
     }
-    else if (params_.long_box && m.length >= params_.long_box_min_length &&
+    else if (params_.steps.long_box && m.length >= kLongBoxMinLength &&
              m.width <= kLongBoxMaxWidthShare * m.length && std::abs(std::remainder(m.yaw - heading, M_PI)) <= max_off &&
              std::abs(std::remainder(m.yaw - t.extent_yaw, 0.5 * M_PI)) > kMinAxesTurn)
     {
@@ -486,16 +291,15 @@ bool Tracker::fastEnough(const Track& t, double sigmas) const
 void Tracker::findCommonMotion(double stamp)
 {
   common_ = CommonMotion{};
-  if (!params_.common_motion) return;
+  if (!params_.steps.common_motion) return;
   common_seen_.clear();
   for (const Track& t : tracks_)
     if (t.reported() && t.last_hit >= stamp && finite(t.x, t.P))
       common_seen_.push_back(SeenTrack{ t.position(), t.decisionVelocity(), t.speedSigma() });
   const auto sensor =
       std::find_if(measurements_.begin(), measurements_.end(), [](const Measurement& x) { return x.has_sensor; });
-  const CommonMotionParams p{ params_.common_motion_min_tracks, params_.common_motion_share,
-                              params_.common_motion_sigmas,     params_.common_motion_max_speed,
-                              params_.common_turn,              params_.common_motion_max_turn_rate };
+  CommonMotionParams p;
+  p.turn = params_.steps.common_turn;
   common_ = fitCommonMotion(common_seen_, sensor != measurements_.end() ? &sensor->sensor : nullptr, p);
   counts_.common_motion_scans += common_.found;
   counts_.common_turn_scans += common_.found && common_.turn_rate != 0.0;
@@ -512,17 +316,17 @@ void Tracker::decideMotion(Track& t, double stamp) const
   }
   e.free_space_check = free_now_;
   e.motion_seen = t.motion_seen;
-  const MotionDecisionParams p{ params_.moving_speed, params_.motion_sigmas, params_.free_space_motion_sigmas,
+  const MotionDecisionParams p{ params_.moving_speed, params_.motion_sigmas, kFreeSpaceMotionSigmas,
                                 params_.stopped_speed, params_.stopped_time };
   t.motion = core::decideMotion(e, stamp, t.still_since, p);
 }
 
 bool Tracker::smallWalker(const Track& t) const
 {
-  const double small = params_.free_space_small_size, least = params_.free_space_small_min_extent;
+  const double small = params_.steps.small_free_space ? params_.pedestrian_size : 0.0, least = kSmallMinExtent;
   const bool thick = t.extent_length >= least && t.extent_width >= least;
   return small > 0.0 && t.extent_length <= small && t.extent_width <= small && thick &&
-         t.speed() <= params_.free_space_small_max_speed;
+         t.speed() <= kWalkingMaxSpeed;
 }
 
 void Tracker::seeFreeSpace(Track& t, double stamp)
@@ -539,7 +343,7 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     const int i = idx[k * idx.size() / n];
     if (i >= 0 && i < static_cast<int>(map_points_.size())) now.points.push_back(map_points_[i]);
   }
-  if (!t.motion_seen && fastEnough(t, params_.free_space_motion_sigmas))
+  if (!t.motion_seen && fastEnough(t, kFreeSpaceMotionSigmas))
   {
     const bool small = smallWalker(t);
     // It left: the returns of one earlier sighting lie in the free space of this scan.
@@ -554,14 +358,14 @@ void Tracker::seeFreeSpace(Track& t, double stamp)
     const auto came = std::count_if(now.points.begin(), now.points.end(), seenFreeBefore);
     t.motion_seen = left || (!now.points.empty() && static_cast<double>(came) >=
                                                         params_.free_space_share * static_cast<double>(now.points.size()));
-    if (!t.motion_seen && params_.walked && small && t.consecutive_hits >= params_.walk_min_hits &&
+    if (!t.motion_seen && params_.steps.walked && small && t.consecutive_hits >= kWalkMinHits &&
         !t.sightings.empty())
     {
       const Sighting& earliest = t.sightings.front();
       const double dt = stamp - earliest.stamp;
       const Point2 common = commonMotionAt(t.position());
       if (std::hypot(t.x(0) - earliest.position.x - common.x * dt, t.x(1) - earliest.position.y - common.y * dt) >=
-          params_.walk_distance)
+          kWalkDistance)
       {
         t.motion_seen = true;
         ++counts_.walked;
@@ -589,8 +393,8 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
     reset();
   }
   last_pose_ = pose;
-  free_now_ = scan && params_.free_space_check;
-  const bool open_ends = scan && params_.open_ends;
+  free_now_ = scan && params_.steps.free_space_check;
+  const bool open_ends = scan && params_.steps.open_ends;
   if (free_now_ || open_ends)
   {
     // The free-space check compares the scans of free_space_time; step open ends needs this scan's only.
@@ -599,7 +403,7 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
                                     [&](const SeenFree& f) { return f.stamp() < oldest || f.stamp() >= stamp; }),
                      seen_free_.end());
     seen_free_.emplace_back(*scan, pose, stamp, params_.free_space_margin,
-                            params_.free_space_small_size > 0.0 ? params_.free_space_small_margin : -1.0);
+                            params_.steps.small_free_space ? kSmallFreeSpaceMargin : -1.0);
   }
   else
     seen_free_.clear();
@@ -631,7 +435,7 @@ void Tracker::update(double stamp, const Pose2& pose, const ObstaclePoints& retu
   capMeasurements(found);
   for (Measurement& m : found)
   {
-    if (open_ends) findOpenEnds(m, seen_free_.back(), *scan, pose, params_.open_end_distance);
+    if (open_ends) findOpenEnds(m, seen_free_.back(), *scan, pose, kOpenEndDistance);
   }
   own_measurements_ = std::move(found);
   update(stamp, own_measurements_);
@@ -653,7 +457,7 @@ void Tracker::dropDuplicates(std::vector<Track>& tracks, double stamp)
   std::vector<double> reach;  // how far from its centre the grown box reaches
   boxes.reserve(moving.size());
   reach.reserve(moving.size());
-  const double margin = params_.fragment_margin;
+  const double margin = kFragmentMargin;
   for (std::size_t j : moving)
   {
     boxes.push_back(objectBox(tracks[j], params_, measurements_));
@@ -747,11 +551,11 @@ void Tracker::update(double stamp, const std::vector<Measurement>& measurements)
     decideMotion(t, stamp);
     kept.push_back(std::move(t));
   }
-  if (params_.duplicates) dropDuplicates(kept, stamp);
+  if (params_.steps.duplicates) dropDuplicates(kept, stamp);
   startTracks(kept, used, stamp);
   tracks_ = std::move(kept);
   counts_.peak_tracks = std::max<std::uint64_t>(counts_.peak_tracks, tracks_.size());
-  if (params_.hidden_centre) rememberSeenBoxes();
+  if (params_.steps.hidden_centre) rememberSeenBoxes();
 }
 
 void Tracker::capMeasurements(std::vector<Measurement>& found)
@@ -804,17 +608,17 @@ void Tracker::startTracks(std::vector<Track>& kept, const std::vector<char>& use
   // Step fragments: the box of a moving track seen this scan (with step duplicates, its object box), grown by the
   // margin, holds the centroid of a cluster no track took; with step duplicates the cluster is that track's piece.
   std::vector<std::pair<std::size_t, ObjectBox>> moving_boxes;
-  if (params_.fragments)
+  if (params_.steps.fragments)
     for (std::size_t j = 0; j < seen_tracks; ++j)
       if (kept[j].motion == TrackMotion::kMoving && kept[j].last_hit >= stamp)
-        moving_boxes.emplace_back(j, params_.duplicates ? objectBox(kept[j], params_, measurements_) : ownBox(kept[j]));
+        moving_boxes.emplace_back(j, params_.steps.duplicates ? objectBox(kept[j], params_, measurements_) : ownBox(kept[j]));
   std::vector<std::size_t> starts;
   for (std::size_t m = 0; m < measurements_.size(); ++m)
   {
     if (used[m]) continue;
     const Measurement& z = measurements_[m];
     const auto owner = std::find_if(moving_boxes.begin(), moving_boxes.end(), [&](const auto& jb) {
-      return inBox(jb.second, z.centroid, params_.fragment_margin);
+      return inBox(jb.second, z.centroid, kFragmentMargin);
     });
     if (owner == moving_boxes.end())
     {
@@ -822,7 +626,7 @@ void Tracker::startTracks(std::vector<Track>& kept, const std::vector<char>& use
       continue;
     }
     ++counts_.fragments;
-    if (params_.duplicates) kept[owner->first].fragments.push_back(static_cast<int>(m));
+    if (params_.steps.duplicates) kept[owner->first].fragments.push_back(static_cast<int>(m));
   }
   // Within max_tracks, the clusters nearest the sensor start their tracks (in the measurements' order).
   const std::size_t room = kept.size() < static_cast<std::size_t>(params_.max_tracks)
@@ -849,7 +653,7 @@ Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
   t.x << z.centroid.x + mu * cu - mv * su, z.centroid.y + mu * su + mv * cu, 0.0, 0.0;
   t.P.setZero();
   t.P.topLeftCorner<2, 2>() = z.covariance;
-  t.P(2, 2) = t.P(3, 3) = params_.initial_speed_sigma * params_.initial_speed_sigma;
+  t.P(2, 2) = t.P(3, 3) = kInitialSpeedSigma * kInitialSpeedSigma;
   t.manoeuvres = manoeuvres();
   if (t.manoeuvres)
     t.imm.reset(t.x, t.P, params_.acceleration_sigma * params_.acceleration_sigma, manoeuvreModel().stationaryManoeuvre());
@@ -895,7 +699,7 @@ SparseCosts Tracker::gate() const
 
 std::optional<double> Tracker::gateCost(const Track& t, const Measurement& z) const
 {
-  if (z.split && std::max(t.extent_length, t.extent_width) > params_.background_split_size) return std::nullopt;
+  if (z.split && std::max(t.extent_length, t.extent_width) > params_.pedestrian_size) return std::nullopt;
   const Point2 ref = referencePoint(t, z);
   const Eigen::Vector2d y(ref.x - t.x(0), ref.y - t.x(1));
   if (y.norm() > params_.max_gate_distance) return std::nullopt;  // before the covariance: most pairs end here

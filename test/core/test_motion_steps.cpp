@@ -661,7 +661,7 @@ TEST(MotionSteps, TrackScanLetsAMoverTakeCAndNOnlyWithoutAPrior)
       const std::string what = std::string(mover.what) + ", step " + (c.step ? "on" : "off") +
                                (c.with_prior ? ", with a prior" : ", no prior");
       Profile profile = defaultProfile();
-      profile.tracker.evidence_without_map = c.step;
+      profile.tracker.steps.movers_without_map = c.step;
       core::Run run(profile);
       const GridGeometry& g = run.grid.geometry();
       PriorWindow pavement;
@@ -861,7 +861,7 @@ TEST(MotionSteps, BuildingBackgroundFlagsTheReturnsOnAMappedFacadeFromItsFirstSc
     for (const bool with_prior : { true, false })
     {
       Profile profile = defaultProfile();
-      profile.tracker.building_background = step;
+      profile.tracker.steps.building_background = step;
       core::Run run(profile);
       run.step(world, pose, &prior);
       CellIndex beyond;

@@ -4,8 +4,12 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include "map_aided_fusion/core/parameters.hpp"
+#include "map_aided_fusion/core/profiles.hpp"
 #include "map_aided_fusion/core/track_evidence.hpp"
 #include "map_aided_fusion/core/tracker.hpp"
 
@@ -251,6 +255,66 @@ TEST(Tracker, TheAssociationsGridFindsEveryPairTheGateAllows)
   ASSERT_EQ(tracker.tracks().size(), ids.size());
   for (std::size_t k = 0; k < ids.size(); ++k) EXPECT_EQ(tracker.tracks()[k].id, ids[k]);
   EXPECT_EQ(tracker.counts().tracks_created, ids.size());
+}
+
+// tracker_steps_off names the steps of doc/steps.md: each tracker step of addedSteps() is one switch of the same
+// name, which that step's disable() turns off alone, and every switch is such a step.
+TEST(TrackerSteps, EachAddedTrackerStepIsOneSwitchOfTheSameName)
+{
+  std::set<std::string> switched;
+  for (const AddedStep& step : addedSteps())
+  {
+    Profile p = defaultProfile();
+    ASSERT_TRUE(stepsOff(p.tracker.steps).empty()) << "every step on by default";
+    step.disable(p);
+    const std::vector<std::string> off = stepsOff(p.tracker.steps);
+    if (off.empty()) continue;  // not the tracker's
+    EXPECT_EQ(off, std::vector<std::string>{ step.name }) << step.name;
+    EXPECT_TRUE(step.enabled(defaultProfile())) << step.name;
+    EXPECT_FALSE(step.enabled(p)) << step.name;
+    switched.insert(step.name);
+  }
+  std::set<std::string> names;
+  for (const TrackerStepSwitch& w : trackerStepSwitches()) names.insert(w.name);
+  EXPECT_EQ(names.size(), trackerStepSwitches().size()) << "no name twice";
+  EXPECT_EQ(switched, names);
+  const Profile paper = paperProfile();
+  EXPECT_EQ(stepsOff(paper.tracker.steps).size(), names.size()) << "the paper profile has them all off";
+}
+
+TEST(TrackerSteps, StepsOffRoundTripsInTheSwitchesOrderAndRefusesAnUnknownName)
+{
+  const TrackerSteps s = stepsWithOff({ "box_fit", "fragments", "box_fit" });
+  EXPECT_FALSE(s.box_fit);
+  EXPECT_FALSE(s.fragments);
+  EXPECT_TRUE(s.duplicates);
+  EXPECT_EQ(stepsOff(s), (std::vector<std::string>{ "fragments", "box_fit" })) << "trackerStepSwitches()' order";
+  EXPECT_EQ(stepsOff(stepsWithOff(stepsOff(s))), stepsOff(s));
+  EXPECT_TRUE(stepsOff(stepsWithOff({})).empty());
+  try
+  {
+    stepsWithOff({ "fragments", "fragmnets" });
+    FAIL() << "a misspelt step accepted";
+  }
+  catch (const ParameterError& e)
+  {
+    EXPECT_EQ(e.parameter(), "tracker_steps_off");
+    EXPECT_NE(std::string(e.what()).find("fragmnets"), std::string::npos) << e.what();
+  }
+  // Read and written through forEachParam() as the list of names.
+  TrackerParams p;
+  forEachParam(p, [](const std::string& name, auto& value, const ParamDoc&) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(value)>, std::vector<std::string>>)
+      if (name == "tracker_steps_off") value = { "walked", "manoeuvres" };
+  });
+  EXPECT_FALSE(p.steps.walked);
+  EXPECT_FALSE(p.steps.manoeuvres);
+  std::vector<std::string> written;
+  forEachParam(p, [&](const std::string& name, auto& value, const ParamDoc&) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(value)>, std::vector<std::string>>)
+      if (name == "tracker_steps_off") written = value;
+  });
+  EXPECT_EQ(written, (std::vector<std::string>{ "walked", "manoeuvres" }));
 }
 
 TEST(Tracker, ParametersAreValidatedByName)
@@ -570,7 +634,7 @@ TEST(Tracker, EvidenceCoversTheCellsOfTheLastClusterWithTheMotionProbability)
   EXPECT_EQ(got_interior, expected_interior);
   EXPECT_EQ(got.size() + got_interior.size(), cells.size()) << "one entry per cell";
   TrackerParams no_box;
-  no_box.evidence_box = false;
+  no_box.steps.track_box = false;
   Tracker returns_only(no_box);
   for (int k = 0; k <= 8; ++k)
   {
@@ -584,10 +648,15 @@ TEST(Tracker, EvidenceCoversTheCellsOfTheLastClusterWithTheMotionProbability)
   }
   EXPECT_EQ(trackEvidence(returns_only, g).size(), expected.size());
   TrackerParams off;
-  off.evidence_weight = 0.0;
+  off.steps.track_evidence = false;
   Tracker silent(off);
   silent.update(0.0, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
   EXPECT_TRUE(trackEvidence(silent, g).empty());
+  TrackerParams weightless;
+  weightless.evidence_weight = 0.0;
+  Tracker weightless_tracker(weightless);
+  weightless_tracker.update(0.0, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
+  EXPECT_TRUE(trackEvidence(weightless_tracker, g).empty());
 }
 
 namespace {
@@ -715,7 +784,7 @@ TEST(Tracker, FreeSpaceCheckTellsAMoverFromAWallFragmentThatSlidesAlong)
   // (all that is seen of it) whose visible part slides at 5 m/s as if the view changed, space behind the wall not seen.
   auto run = [](bool check, std::uint32_t& car_moving_from, bool& wall_moving) {
     TrackerParams p;
-    p.free_space_check = check;
+    p.steps.free_space_check = check;
     Tracker tracker(p);
     car_moving_from = 0;
     wall_moving = false;
@@ -788,28 +857,20 @@ int carMovingFrom(const TrackerParams& params, double speed, bool with_scan, dou
 TEST(Tracker, FreeSpaceMotionSigmasApplyOnlyWhileTheCheckRuns)
 {
   TrackerParams p;
-  ASSERT_DOUBLE_EQ(p.free_space_motion_sigmas, 0.5);
+  ASSERT_DOUBLE_EQ(kFreeSpaceMotionSigmas, 0.5);
   ASSERT_DOUBLE_EQ(p.motion_sigmas, 1.5);
   // Placed by its open rear end (step open anchor), the car's speed is certain enough for both thresholds by the
   // scan free space shows its motion: without that step the scene tells them apart.
-  p.open_anchor = false;
+  p.steps.open_anchor = false;
   double s = 0.0, sigma = 0.0;
   const int relaxed = carMovingFrom(p, 1.5, true, s, sigma);
   ASSERT_GE(relaxed, 0);
-  EXPECT_GT(s - p.free_space_motion_sigmas * sigma, p.moving_speed);
-  EXPECT_LE(s - p.motion_sigmas * sigma, p.moving_speed) << "the scene must tell the two thresholds apart";
-  TrackerParams strict = p;
-  strict.free_space_motion_sigmas = p.motion_sigmas;
-  const int strict_from = carMovingFrom(strict, 1.5, true, s, sigma);
-  EXPECT_GT(strict_from, relaxed) << "motion_sigmas standard deviations take longer";
-  EXPECT_GT(s - p.motion_sigmas * sigma, p.moving_speed);
-  // Without a ScanGrid the velocity alone decides, with motion_sigmas whatever free_space_motion_sigmas says.
-  TrackerParams zero = p;
-  zero.free_space_motion_sigmas = 0.0;
-  double s0 = 0.0, sigma0 = 0.0;
+  EXPECT_GT(s - kFreeSpaceMotionSigmas * sigma, p.moving_speed);
+  EXPECT_LE(s - p.motion_sigmas * sigma, p.moving_speed) << "moving while motion_sigmas would not yet clear";
+  // Without a ScanGrid the velocity alone decides, with motion_sigmas: later.
   const int alone = carMovingFrom(p, 1.5, false, s, sigma);
   ASSERT_GE(alone, 0);
-  EXPECT_EQ(carMovingFrom(zero, 1.5, false, s0, sigma0), alone);
+  EXPECT_GT(alone, relaxed) << "motion_sigmas standard deviations take longer";
   EXPECT_GT(s - p.motion_sigmas * sigma, p.moving_speed);
 }
 
@@ -847,20 +908,18 @@ int walkBesideAFacade(const TrackerParams& params, double speed, bool sliver)
 TEST(Tracker, SmallFreeSpaceLetsAPedestrianBesideAFacadeMove)
 {
   TrackerParams p;
-  ASSERT_DOUBLE_EQ(p.free_space_small_margin, 0.0);
+  ASSERT_DOUBLE_EQ(kSmallFreeSpaceMargin, 0.0);
+  ASSERT_DOUBLE_EQ(kSmallMinExtent, 0.1);
   const int from = walkBesideAFacade(p, 1.4, false);
   EXPECT_GE(from, p.confirm_hits - 1) << "tentative before";
   EXPECT_LE(from, 10) << "a pedestrian at 1.4 m/s is moving within a second";
   TrackerParams off = p;
-  off.free_space_small_size = 0.0;
+  off.steps.small_free_space = false;
   EXPECT_EQ(walkBesideAFacade(off, 1.4, false), -1) << "the general margin never sees its cells free";
   // 3 m/s: at 2.5 m/s the speed estimated from the first three scans is still under the 2 m/s cap when the track is
   // confirmed, and that first check passes.
   EXPECT_EQ(walkBesideAFacade(p, 3.0, false), -1) << "faster than a walk: the general margin";
   EXPECT_EQ(walkBesideAFacade(p, 1.4, true), -1) << "a sliver thinner than the least extent: the general margin";
-  TrackerParams any_extent = p;
-  any_extent.free_space_small_min_extent = 0.0;
-  EXPECT_GE(walkBesideAFacade(any_extent, 1.4, true), p.confirm_hits - 1) << "the sliver is moving without the least extent";
 }
 
 namespace {
@@ -889,7 +948,7 @@ Tracker carWithACompanion(const TrackerParams& params, double speed, double offs
 TEST(Tracker, FragmentsOfAMovingTrackStartNoTrack)
 {
   TrackerParams p;
-  ASSERT_DOUBLE_EQ(p.fragment_margin, 1.0);
+  ASSERT_DOUBLE_EQ(kFragmentMargin, 1.0);
   // 0.8 m beside the moving car's side (its box grown by 1 m): a fragment, no track of its own, counted.
   const Tracker beside = carWithACompanion(p, 8.0, 0.8);
   ASSERT_EQ(beside.tracks().size(), 1u);
@@ -898,8 +957,8 @@ TEST(Tracker, FragmentsOfAMovingTrackStartNoTrack)
   EXPECT_EQ(beside.counts().tracks_created, 1u);
   // The step off (and step duplicates, which deletes the second track once both move): a second track.
   TrackerParams off = p;
-  off.fragments = false;
-  off.duplicates = false;
+  off.steps.fragments = false;
+  off.steps.duplicates = false;
   const Tracker without = carWithACompanion(off, 8.0, 0.8);
   EXPECT_EQ(without.tracks().size(), 2u);
   EXPECT_EQ(without.counts().fragments, 0u);
@@ -913,20 +972,14 @@ TEST(Tracker, FragmentsOfAMovingTrackStartNoTrack)
 TEST(Tracker, FreeSpaceParametersAreValidatedByName)
 {
   expectRefusedByName({
-      { "tracker_fragment_margin", [](TrackerParams& p) { p.fragment_margin = -0.1; } },
-      { "tracker_fragment_margin", [](TrackerParams& p) { p.fragment_margin = std::nan(""); } },
-      { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = -0.1; } },
-      { "tracker_free_space_small_size", [](TrackerParams& p) { p.free_space_small_size = 1e3; } },
-      { "tracker_free_space_small_margin", [](TrackerParams& p) { p.free_space_small_margin = 0.6; } },
-      { "tracker_free_space_small_min_extent", [](TrackerParams& p) { p.free_space_small_min_extent = -1.0; } },
-      { "tracker_free_space_small_max_speed", [](TrackerParams& p) { p.free_space_small_max_speed = std::nan(""); } },
+      { "tracker_pedestrian_size", [](TrackerParams& p) { p.pedestrian_size = 0.0; } },
+      { "tracker_pedestrian_size", [](TrackerParams& p) { p.pedestrian_size = 1e3; } },
+      { "tracker_pedestrian_size", [](TrackerParams& p) { p.pedestrian_size = std::nan(""); } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 0.0; } },
       { "tracker_free_space_share", [](TrackerParams& p) { p.free_space_share = 1.5; } },
       { "tracker_free_space_margin", [](TrackerParams& p) { p.free_space_margin = -0.1; } },
       { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = 0.0; } },
-      { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } },
-      { "tracker_free_space_motion_sigmas", [](TrackerParams& p) { p.free_space_motion_sigmas = -0.5; } },
-      { "tracker_free_space_motion_sigmas", [](TrackerParams& p) { p.free_space_motion_sigmas = 11.0; } } });
+      { "tracker_free_space_time", [](TrackerParams& p) { p.free_space_time = std::nan(""); } } });
 }
 
 namespace {
@@ -968,7 +1021,7 @@ std::vector<std::uint32_t> driveAndTurn(const TrackerParams& params, double leng
 TEST(Tracker, HeadingBoxTurnsTheBoxOfAShortObjectThatTurns)
 {
   TrackerParams on, off;
-  off.heading_box = false;
+  off.steps.heading_box = false;
   Track with, without;
   // A cyclist (1.6 × 0.6 m) turning by 48° in all.
   const std::vector<std::uint32_t> ids = driveAndTurn(on, 1.6, 0.6, 6.0, with);
@@ -976,9 +1029,9 @@ TEST(Tracker, HeadingBoxTurnsTheBoxOfAShortObjectThatTurns)
   ASSERT_FALSE(ids.empty());
   for (const std::uint32_t id : ids) EXPECT_EQ(id, ids.front()) << "one id all along";
   EXPECT_EQ(with.motion, TrackMotion::kMoving);
-  // Its box turned with it: its axes within heading_box_angle of the heading (48°), so its width is at most that of the
-  // outline seen that much askew, 0.6 cos a + 1.6 sin a (plus the outline's 0.1 m spacing).
-  const double a = on.heading_box_angle * M_PI / 180.0;
+  // Its box turned with it: its axes within kHeadingBoxAngleDeg of the heading (48°), so its width is at most that of
+  // the outline seen that much askew, 0.6 cos a + 1.6 sin a (plus the outline's 0.1 m spacing).
+  const double a = kHeadingBoxAngleDeg * M_PI / 180.0;
   const double askew_width = 0.6 * std::cos(a) + 1.6 * std::sin(a) + 0.1;
   EXPECT_LE(std::abs(std::remainder(with.extent_yaw - 48.0 * M_PI / 180.0, 0.5 * M_PI)), a + 1e-9);
   EXPECT_LE(std::min(with.extent_length, with.extent_width), askew_width);
@@ -992,7 +1045,7 @@ TEST(Tracker, HeadingBoxLeavesTheBoxOfALongObjectAlone)
 {
   TrackerParams on;
   Track van;
-  // A van (5 × 2 m), longer than heading_box_max_length and shorter than long_box_min_length: its box keeps the axes
+  // A van (5 × 2 m), longer than kHeadingBoxMaxLength and shorter than kLongBoxMinLength: its box keeps the axes
   // of its first cluster.
   driveAndTurn(on, 5.0, 2.0, 6.0, van);
   EXPECT_NEAR(std::remainder(van.extent_yaw, 0.5 * M_PI), 0.0, 0.05);
@@ -1003,10 +1056,10 @@ TEST(Tracker, HeadingBoxLeavesTheBoxOfALongObjectAlone)
 TEST(Tracker, LongBoxTurnsTheBoxOfABusThatTurns)
 {
   TrackerParams on, off;
-  ASSERT_TRUE(on.long_box);
-  ASSERT_LT(on.long_box_min_length, 12.0);
-  ASSERT_GT(12.0, on.heading_box_max_length) << "the bus is not step heading box's";
-  off.long_box = false;
+  ASSERT_TRUE(on.steps.long_box);
+  ASSERT_LT(kLongBoxMinLength, 12.0);
+  ASSERT_GT(12.0, kHeadingBoxMaxLength) << "the bus is not step heading box's";
+  off.steps.long_box = false;
   Track with, without;
   constexpr double kTurn = 16.0;
   const std::vector<std::uint32_t> ids = driveAndTurn(on, 12.0, 2.5, kTurn / 8.0, with);
@@ -1025,24 +1078,6 @@ TEST(Tracker, LongBoxTurnsTheBoxOfABusThatTurns)
   const double a = kTurn * M_PI / 180.0, askew_width = 2.5 * std::cos(a) + 12.0 * std::sin(a);
   EXPECT_NEAR(std::remainder(without.extent_yaw, 0.5 * M_PI), 0.0, 0.05);
   EXPECT_GT(std::min(without.extent_length, without.extent_width), askew_width - 0.2);
-}
-
-TEST(Tracker, LongBoxMinLengthIsValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_long_box_min_length", [](TrackerParams& p) { p.long_box_min_length = -1.0; } },
-      { "tracker_long_box_min_length", [](TrackerParams& p) { p.long_box_min_length = 101.0; } },
-      { "tracker_long_box_min_length", [](TrackerParams& p) { p.long_box_min_length = std::nan(""); } } });
-}
-
-TEST(Tracker, HeadingBoxParametersAreValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = -1.0; } },
-      { "tracker_heading_box_angle", [](TrackerParams& p) { p.heading_box_angle = 50.0; } },
-      { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = -0.5; } },
-      { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = 1e3; } },
-      { "tracker_heading_box_max_length", [](TrackerParams& p) { p.heading_box_max_length = std::nan(""); } } });
 }
 
 namespace {
@@ -1096,7 +1131,7 @@ TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
 {
   const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
   TrackerParams p;
-  const double len = p.evidence_hidden_length, margin = 0.3;  // cells well inside or well outside, at 0.5 m
+  const double len = p.vehicle_length, margin = 0.3;  // cells well inside or well outside, at 0.5 m
   // The body lies away from the sensor (at the origin: +x) behind a rear face (the vehicle drives away) and behind a
   // front face (it drives towards the sensor): every cell of the 4 m × 1.8 m box.
   for (const double dir : { 1.0, -1.0 })
@@ -1112,25 +1147,19 @@ TEST(Tracker, HiddenLengthExtendsTheBoxOfAVehicleSeenEndOnAwayFromTheSensor)
     EXPECT_EQ(cellsIn(cells, g, -1e9, face - margin, 5.0), 0u) << "direction " << dir;
     for (const CellMotion& c : cells) EXPECT_EQ(c.motion, CellClass::kMoving);
   }
-  // A face narrower than evidence_end_width (a cyclist's), or the step off: the box is the face only (without step
+  // A face narrower than kVehicleMinEndWidth (a cyclist's), or the step off: the box is the face only (without step
   // small box, which grows a face this small to a pedestrian's size).
   double face = 0.0;
   TrackerParams no_small_box = p;
-  no_small_box.evidence_small_box = false;
+  no_small_box.steps.small_box = false;
   const auto narrow = faceEvidence(no_small_box, g, 10.0, 1.0, 0.6, face);
   EXPECT_FALSE(narrow.empty());
   EXPECT_EQ(cellsIn(narrow, g, face + margin, 1e9, 5.0), 0u);
-  for (const bool length_zero : { true, false })
-  {
-    TrackerParams off;
-    if (length_zero)
-      off.evidence_hidden_length = 0.0;
-    else
-      off.hidden_length = false;
-    const auto without = faceEvidence(off, g, 10.0, 1.0, 1.8, face);
-    EXPECT_FALSE(without.empty());
-    EXPECT_EQ(cellsIn(without, g, face + margin, 1e9, 5.0), 0u) << (length_zero ? "length 0" : "step off");
-  }
+  TrackerParams off;
+  off.steps.hidden_length = false;
+  const auto without = faceEvidence(off, g, 10.0, 1.0, 1.8, face);
+  EXPECT_FALSE(without.empty());
+  EXPECT_EQ(cellsIn(without, g, face + margin, 1e9, 5.0), 0u) << "step off";
 }
 
 namespace {
@@ -1166,8 +1195,8 @@ TEST(Tracker, DuplicatesLeaveOneTrackPerObjectAndTheirReturnsTakeItsMotion)
 {
   const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
   TrackerParams p;
-  ASSERT_TRUE(p.duplicates);
-  ASSERT_DOUBLE_EQ(p.fragment_margin, 1.0);
+  ASSERT_TRUE(p.steps.duplicates);
+  ASSERT_DOUBLE_EQ(kFragmentMargin, 1.0);
   std::size_t ring_cell = 0;
   // The block 2.5 m beyond the face lies in the car's object box (step hidden length: 4 m away from the sensor
   // behind its face): its track is deleted once both move, and from then on the block is the car's fragment, outside
@@ -1191,7 +1220,7 @@ TEST(Tracker, DuplicatesLeaveOneTrackPerObjectAndTheirReturnsTakeItsMotion)
   EXPECT_FLOAT_EQ(ring->weight, static_cast<float>(p.evidence_weight * motionProbability(car, p)));
   // The step off: two moving tracks on one car.
   TrackerParams off = p;
-  off.duplicates = false;
+  off.steps.duplicates = false;
   const Tracker two = faceAndRing(off, 2.5, g, ring_cell);
   ASSERT_EQ(two.tracks().size(), 2u);
   for (const Track& t : two.tracks()) EXPECT_EQ(t.motion, TrackMotion::kMoving);
@@ -1205,7 +1234,7 @@ TEST(Tracker, DuplicatesLeaveOneTrackPerObjectAndTheirReturnsTakeItsMotion)
 TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)
 {
   TrackerParams p;
-  const double len = p.evidence_hidden_length, width = 1.8, depth = 0.05;  // the face's returns: x and x + depth
+  const double len = p.vehicle_length, width = 1.8, depth = 0.05;  // the face's returns: x and x + depth
   constexpr double kTolerance = 0.2;  // m: the filtered position against the last face
   // Driving away (the rear face) and towards the sensor (the front face): the body lies away from the sensor, so
   // the object's centre is half the length behind the face's near side, and its box the hidden length's.
@@ -1229,7 +1258,7 @@ TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)
     ASSERT_EQ(all.size(), 1u);
     EXPECT_EQ(all[0].centre.x, b.centre.x);
   }
-  // A face narrower than evidence_end_width (a cyclist's), or the step off: the track's own position and box.
+  // A face narrower than kVehicleMinEndWidth (a cyclist's), or the step off: the track's own position and box.
   auto expectOwnBox = [](const TrackerParams& params, double width) {
     double face = 0.0;
     const Tracker tracker = faceTracker(params, 10.0, 1.0, width, face);
@@ -1244,23 +1273,20 @@ TEST(Tracker, HiddenCentreReportsTheVehicleBehindItsFace)
   };
   expectOwnBox(p, 0.6);
   TrackerParams off = p;
-  off.hidden_centre = false;
+  off.steps.hidden_centre = false;
   expectOwnBox(off, width);
-  TrackerParams no_length = p;
-  no_length.evidence_hidden_length = 0.0;
-  expectOwnBox(no_length, width);
 }
 
 TEST(Tracker, HiddenCentreKeepsTheLastSeenBoxWhileTheTrackCoasts)
 {
   TrackerParams p;
-  p.manoeuvre_jerk_sigma = 0.0;  // the constant-velocity prediction, which the coasting box follows below
-  const double len = p.evidence_hidden_length, width = 1.8;
+  p.steps.manoeuvres = false;  // the constant-velocity prediction, which the coasting box follows below
+  const double len = p.vehicle_length, width = 1.8;
   for (const bool step : { true, false })
   {
     SCOPED_TRACE(step ? "step hidden centre" : "without it");
     TrackerParams params = p;
-    params.hidden_centre = step;
+    params.steps.hidden_centre = step;
     double face = 0.0;
     Tracker tracker = faceTracker(params, 10.0, 1.0, width, face);
     ASSERT_EQ(tracker.tracks().size(), 1u);
@@ -1308,10 +1334,10 @@ TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
     return std::pair{ take_n, cells.size() };
   };
   const auto [small, small_cells] = flags(p, 0.6);  // a pedestrian's width, a face 5 cm deep
-  EXPECT_EQ(small, small_cells) << "every cell of a moving track within evidence_small_size";
+  EXPECT_EQ(small, small_cells) << "every cell of a moving track within pedestrian_size";
   EXPECT_EQ(flags(p, 1.8).first, 0u) << "a vehicle's face is wider";
   TrackerParams off = p;
-  off.evidence_small_size = 0.0;
+  off.steps.small_movers = false;
   EXPECT_EQ(flags(off, 0.6).first, 0u) << "the step off";
   // Step small specialised flags exactly the small mover's cells.
   auto specialised = [&](const TrackerParams& params, double width) {
@@ -1327,7 +1353,7 @@ TEST(Tracker, SmallMoversLetTheCellsOfAPedestrianSizedMovingTrackTakeN)
   EXPECT_EQ(specialised(p, 0.6), small_cells);
   EXPECT_EQ(specialised(p, 1.8), 0u);
   TrackerParams not_specialised = p;
-  not_specialised.evidence_small_specialised = false;
+  not_specialised.steps.small_specialised = false;
   EXPECT_EQ(specialised(not_specialised, 0.6), 0u);
 }
 
@@ -1378,7 +1404,7 @@ TEST(Tracker, SmallBoxCoversThePedestrianBehindItsReturns)
 {
   const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };  // cell centres at x, y = k/2 + 1/4
   TrackerParams p;
-  ASSERT_DOUBLE_EQ(p.evidence_small_size, 1.0);
+  ASSERT_DOUBLE_EQ(p.pedestrian_size, 1.0);
   // The returns (x in [11.1, 11.15], |y| <= 0.3) lie in the cells centred at (11.25, ±0.25). The box grows away from
   // the sensor to x = 11.1 + 1 and across to |y| <= 0.5: it also holds the cells centred at (11.75, ±0.25), not those
   // at x = 12.25 nor at |y| = 0.75. Whether the pedestrian walks away from the sensor or towards it.
@@ -1395,27 +1421,23 @@ TEST(Tracker, SmallBoxCoversThePedestrianBehindItsReturns)
   }
   // The step off: the cells of its returns only (the box of the returns holds no other cell centre).
   TrackerParams off = p;
-  off.evidence_small_box = false;
+  off.steps.small_box = false;
   const std::vector<std::pair<double, double>> returns_only{ { 11.25, -0.25 }, { 11.25, 0.25 } };
   EXPECT_EQ(centres(pedestrianEvidence(off, g, 1.0), g), returns_only);
-  // Not for a track larger than evidence_small_size (here 0.5 m, below the 0.6 m width): no small mover.
+  // Not for a track larger than pedestrian_size (here 0.5 m, below the 0.6 m width): no small mover.
   TrackerParams half_metre = p;
-  half_metre.evidence_small_size = 0.5;
+  half_metre.pedestrian_size = 0.5;
   EXPECT_EQ(centres(pedestrianEvidence(half_metre, g, 1.0), g), returns_only);
 }
 
 TEST(Tracker, TrackEvidenceSizeParametersAreValidatedByName)
 {
   expectRefusedByName({
-      { "tracker_evidence_small_size", [](TrackerParams& p) { p.evidence_small_size = -0.5; } },
-      { "tracker_evidence_small_size", [](TrackerParams& p) { p.evidence_small_size = 1e3; } },
-      { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = -1.0; } },
-      { "tracker_evidence_hidden_length", [](TrackerParams& p) { p.evidence_hidden_length = 1e3; } },
-      { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = -0.1; } },
-      { "tracker_evidence_end_width", [](TrackerParams& p) { p.evidence_end_width = std::nan(""); } },
-      { "tracker_evidence_box_margin", [](TrackerParams& p) { p.evidence_box_margin = -0.1; } },
-      { "tracker_evidence_box_margin", [](TrackerParams& p) { p.evidence_box_margin = 0.6 * p.max_object_width; } },
-      { "tracker_evidence_box_margin", [](TrackerParams& p) { p.evidence_box_margin = std::nan(""); } } });
+      { "tracker_vehicle_length", [](TrackerParams& p) { p.vehicle_length = 0.0; } },
+      { "tracker_vehicle_length", [](TrackerParams& p) { p.vehicle_length = 1e3; } },
+      { "tracker_vehicle_length", [](TrackerParams& p) { p.vehicle_length = std::nan(""); } },
+      { "tracker_evidence_weight", [](TrackerParams& p) { p.evidence_weight = -0.1; } },
+      { "tracker_evidence_weight", [](TrackerParams& p) { p.evidence_weight = 1.5; } } });
 }
 
 TEST(Tracker, BoxMarginGivesTheMotionToTheCellsAVehiclesSidesHalfCover)
@@ -1423,9 +1445,10 @@ TEST(Tracker, BoxMarginGivesTheMotionToTheCellsAVehiclesSidesHalfCover)
   // A van 2 m wide whose sides lie on the centres of a row of 0.5 m cells (y = 4.25 and 6.25), driving away along x
   // at 8 m/s from a sensor at the origin. Its rear face's outermost returns are a beam step (5 cm) inside its sides.
   const GridGeometry g{ 0.5, 200, 200, -50.0, -50.0 };
-  auto evidence = [&](double margin, double& face_x) {
+  ASSERT_DOUBLE_EQ(kBoxMargin, 0.1);
+  auto evidence = [&](bool margin, double& face_x) {
     TrackerParams p;
-    p.evidence_box_margin = margin;
+    p.steps.box_margin = margin;
     Tracker tracker(p);
     for (int k = 0; k <= 8; ++k)
     {
@@ -1456,7 +1479,7 @@ TEST(Tracker, BoxMarginGivesTheMotionToTheCellsAVehiclesSidesHalfCover)
     return n;
   };
   double face = 0.0;
-  const auto with = evidence(0.1, face);
+  const auto with = evidence(true, face);
   // Cell centres every 0.5 m in (face + 0.3, face + 3.7): 7 on each side row, as on the rows inside.
   EXPECT_EQ(row(with, face, 4.25), 7u);
   EXPECT_EQ(row(with, face, 6.25), 7u);
@@ -1464,7 +1487,7 @@ TEST(Tracker, BoxMarginGivesTheMotionToTheCellsAVehiclesSidesHalfCover)
   // Not the next rows out: the margin is less than half a cell.
   EXPECT_EQ(row(with, face, 3.75), 0u);
   EXPECT_EQ(row(with, face, 6.75), 0u);
-  const auto without = evidence(0.0, face);
+  const auto without = evidence(false, face);
   EXPECT_EQ(row(without, face, 4.25), 0u);
   EXPECT_EQ(row(without, face, 6.25), 0u);
   EXPECT_EQ(row(without, face, 5.25), 7u);
@@ -1501,7 +1524,7 @@ std::vector<Point2> occluderFace()
 Track emergeFromShadow(bool open_ends, int scans, double& true_x)
 {
   TrackerParams params;
-  params.open_ends = open_ends;
+  params.steps.open_ends = open_ends;
   Tracker tracker(params);
   constexpr double kSpeed = 10.0, kDt = 0.1, kSide = 9.1, kLength = 4.0;
   const double edge = kSide * kOccluderHalf / kOccluderY;
@@ -1590,16 +1613,10 @@ TEST(Tracker, OpenEndsFollowTheFrontOfACarComingOutOfAShadow)
   EXPECT_NEAR(with.extent_length, 4.0, 0.3);
 }
 
-TEST(Tracker, OpenEndDistanceIsValidatedByName)
-{
-  expectRefusedByName({ { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = -0.1; } },
-                        { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = 11.0; } },
-                        { "tracker_open_end_distance", [](TrackerParams& p) { p.open_end_distance = std::nan(""); } } });
-}
 
 namespace {
 
-constexpr int kStaticObjects = 24;  // above tracker_common_motion_min_tracks (20)
+constexpr int kStaticObjects = 24;  // above kCommonMotionMinTracks (20)
 constexpr int kDriftScans = 30;
 
 /// Scan @p k (0.1 s apart) of kStaticObjects static objects 4 m apart and one walker at @p walker_speed along −y, all
@@ -1634,10 +1651,10 @@ std::pair<Tracker, Tracker> runBoth(const TrackerParams& on, const TrackerParams
 TEST(Tracker, CommonMotionOfADriftingPoseIsNoMotion)
 {
   TrackerParams on;
-  ASSERT_TRUE(on.common_motion);
-  ASSERT_LT(on.common_motion_min_tracks, kStaticObjects + 1);
+  ASSERT_TRUE(on.steps.common_motion);
+  ASSERT_LT(kCommonMotionMinTracks, kStaticObjects + 1);
   TrackerParams off = on;
-  off.common_motion = false;
+  off.steps.common_motion = false;
   constexpr double kDrift = 1.2, kWalker = 1.5;
   const auto [with, without] = runBoth(on, off, [&](int k) { return driftScan(k, kDrift, kWalker); });
   ASSERT_EQ(with.tracks().size(), static_cast<std::size_t>(kStaticObjects + 1));
@@ -1672,7 +1689,7 @@ TEST(Tracker, CommonMotionOfADriftingPoseIsNoMotion)
 TEST(Tracker, TrafficFewTracksAndSplitMotionsAreNoCommonMotion)
 {
   TrackerParams on, off;
-  off.common_motion = false;
+  off.steps.common_motion = false;
   auto run = [](const TrackerParams& p, int objects, double v_first, double v_rest, int first_count) {
     Tracker tracker(p);
     for (int k = 0; k < kDriftScans; ++k)
@@ -1708,25 +1725,9 @@ TEST(Tracker, TrafficFewTracksAndSplitMotionsAreNoCommonMotion)
   }
 }
 
-TEST(Tracker, CommonMotionParametersAreValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_common_motion_min_tracks", [](TrackerParams& p) { p.common_motion_min_tracks = 0; } },
-      { "tracker_common_motion_share", [](TrackerParams& p) { p.common_motion_share = 0.0; } },
-      { "tracker_common_motion_share", [](TrackerParams& p) { p.common_motion_share = 1.5; } },
-      { "tracker_common_motion_sigmas", [](TrackerParams& p) { p.common_motion_sigmas = -1.0; } },
-      { "tracker_common_motion_sigmas", [](TrackerParams& p) { p.common_motion_sigmas = std::nan(""); } },
-      { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = -0.1; } },
-      { "tracker_common_motion_max_speed", [](TrackerParams& p) { p.common_motion_max_speed = 1e3; } },
-      { "tracker_common_motion_max_turn_rate", [](TrackerParams& p) { p.common_motion_max_turn_rate = -0.01; } },
-      { "tracker_common_motion_max_turn_rate", [](TrackerParams& p) { p.common_motion_max_turn_rate = 1.1; } },
-      { "tracker_common_motion_max_turn_rate",
-        [](TrackerParams& p) { p.common_motion_max_turn_rate = std::nan(""); } } });
-}
-
 namespace {
 
-constexpr double kTurnRate = 0.03;  // rad/s, below tracker_common_motion_max_turn_rate
+constexpr double kTurnRate = 0.03;  // rad/s, below kCommonMotionMaxTurnRate
 
 /// Scan @p k (0.1 s apart) seen from a sensor at rest at the origin through a heading that drifts at @p turn_rate:
 /// kStaticObjects static objects all round at 10 to 55 m and a walker at 1.5 m/s along −y, the whole scene turned by
@@ -1757,10 +1758,10 @@ std::vector<Measurement> turnScan(int k, double turn_rate, bool sensor)
 TEST(Tracker, CommonTurnOfADriftingHeadingIsNoMotion)
 {
   TrackerParams on;
-  ASSERT_TRUE(on.common_turn);
-  ASSERT_LE(kTurnRate, on.common_motion_max_turn_rate);
+  ASSERT_TRUE(on.steps.common_turn);
+  ASSERT_LE(kTurnRate, kCommonMotionMaxTurnRate);
   TrackerParams off = on;
-  off.common_turn = false;
+  off.steps.common_turn = false;
   const auto [with, without] = runBoth(on, off, [](int k) { return turnScan(k, kTurnRate, true); });
   ASSERT_EQ(with.tracks().size(), static_cast<std::size_t>(kStaticObjects + 1));
   ASSERT_EQ(without.tracks().size(), with.tracks().size());
@@ -1791,7 +1792,7 @@ TEST(Tracker, CommonTurnOfADriftingHeadingIsNoMotion)
 
 // The common motion turns only when the turn is real and its centre is known: a drift without a turn keeps the
 // median (ω = 0, every decision the same as without the step), and so does a turning scene whose measurements do not
-// know the sensor; a turn faster than common_motion_max_turn_rate is not a drift.
+// know the sensor; a turn faster than kCommonMotionMaxTurnRate is not a drift.
 TEST(Tracker, CommonTurnNeedsAKnownSensorAndASignificantSlowTurn)
 {
   struct Case
@@ -1799,15 +1800,13 @@ TEST(Tracker, CommonTurnNeedsAKnownSensorAndASignificantSlowTurn)
     const char* what;
     double turn_rate;
     bool sensor;
-    double max_turn_rate;
   };
-  for (const Case& c : { Case{ "no turn", 0.0, true, 0.05 }, Case{ "no sensor", kTurnRate, false, 0.05 },
-                         Case{ "too fast a turn", kTurnRate, true, 0.5 * kTurnRate } })
+  for (const Case& c : { Case{ "no turn", 0.0, true }, Case{ "no sensor", kTurnRate, false },
+                         Case{ "too fast a turn", 2.0 * kCommonMotionMaxTurnRate, true } })
   {
     TrackerParams on;
-    on.common_motion_max_turn_rate = c.max_turn_rate;
     TrackerParams off = on;
-    off.common_turn = false;
+    off.steps.common_turn = false;
     Tracker with(on), without(off);
     for (int k = 0; k < kDriftScans; ++k)
     {
@@ -1856,8 +1855,8 @@ std::vector<Measurement> wallAndPedestrian(const TrackerParams& p, double wall_l
 TEST(Tracker, BackgroundSplitFindsAPedestrianTouchingAWall)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.background_split);
-  ASSERT_DOUBLE_EQ(p.background_split_size, 1.0);
+  ASSERT_TRUE(p.steps.background_split);
+  ASSERT_DOUBLE_EQ(p.pedestrian_size, 1.0);
   const std::vector<Measurement> found = wallAndPedestrian(p, 30.0, 0.4, false);
   ASSERT_EQ(found.size(), 1u) << "the pedestrian, split off the 30 m wall it touches";
   const Measurement& m = found[0];
@@ -1870,13 +1869,13 @@ TEST(Tracker, BackgroundSplitFindsAPedestrianTouchingAWall)
   EXPECT_EQ(m.returns.size(), 20u);
 
   TrackerParams off = p;
-  off.background_split = false;
+  off.steps.background_split = false;
   EXPECT_TRUE(wallAndPedestrian(off, 30.0, 0.4, false).empty()) << "without the step: one cluster too long";
   EXPECT_TRUE(wallAndPedestrian(p, 30.0, 0.4, false, false).empty()) << "without background flags nothing tells them apart";
   EXPECT_TRUE(wallAndPedestrian(p, 30.0, 0.4, true).empty()) << "returns on background are no piece";
-  EXPECT_TRUE(wallAndPedestrian(p, 30.0, 1.5, false).empty()) << "a piece longer than background_split_size";
+  EXPECT_TRUE(wallAndPedestrian(p, 30.0, 1.5, false).empty()) << "a piece longer than pedestrian_size";
   TrackerParams larger = p;
-  larger.background_split_size = 2.0;
+  larger.pedestrian_size = 2.0;
   EXPECT_EQ(wallAndPedestrian(larger, 30.0, 1.5, false).size(), 1u);
   EXPECT_TRUE(wallAndPedestrian(p, 5.0, 0.4, false).empty())
       << "a short cluster dropped for its background share alone is not split";
@@ -1940,37 +1939,21 @@ int walkUnseen(const TrackerParams& params, double speed, double length = 0.4, s
 TEST(Tracker, WalkedLetsAPedestrianWhoseGroundIsHiddenMove)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.walked);
-  ASSERT_EQ(p.walk_min_hits, 10);
-  ASSERT_DOUBLE_EQ(p.walk_distance, 0.5);
+  ASSERT_TRUE(p.steps.walked);
+  ASSERT_EQ(kWalkMinHits, 10);
+  ASSERT_DOUBLE_EQ(kWalkDistance, 0.5);
   std::uint64_t walked = 0;
   const int from = walkUnseen(p, 0.8, 0.4, &walked);
   EXPECT_EQ(walked, 1u) << "counted";
   // Scan 9 is its 10th association; it moved 0.72 m since its first sighting, 0.9 s before.
-  EXPECT_EQ(from, p.walk_min_hits - 1);
+  EXPECT_EQ(from, kWalkMinHits - 1);
   TrackerParams off = p;
-  off.walked = false;
+  off.steps.walked = false;
   EXPECT_EQ(walkUnseen(off, 0.8), -1) << "free space never shows its motion";
-  TrackerParams longer = p;
-  longer.walk_min_hits = 15;
-  EXPECT_EQ(walkUnseen(longer, 0.8), 14);
-  TrackerParams farther = p;
-  farther.walk_distance = 1.0;
-  EXPECT_EQ(walkUnseen(farther, 0.8), -1) << "0.8 m/s covers at most 0.88 m within the sightings kept (1 s)";
+  // At 0.3 m/s it covers at most 0.33 m within the sightings kept (free_space_time, 1 s), under kWalkDistance.
+  EXPECT_EQ(walkUnseen(p, 0.3), -1) << "too slow to cover kWalkDistance within the sightings kept";
   EXPECT_EQ(walkUnseen(p, 0.0), -1) << "a pedestrian standing still";
   EXPECT_EQ(walkUnseen(p, 0.8, 2.0), -1) << "a 2 m object is no small walker";
-}
-
-TEST(Tracker, BackgroundSplitAndWalkedParametersAreValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_background_split_size", [](TrackerParams& p) { p.background_split_size = 0.0; } },
-      { "tracker_background_split_size", [](TrackerParams& p) { p.background_split_size = 5.0; } },
-      { "tracker_background_split_size", [](TrackerParams& p) { p.background_split_size = std::nan(""); } },
-      { "tracker_walk_min_hits", [](TrackerParams& p) { p.walk_min_hits = 0; } },
-      { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = 0.0; } },
-      { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = 11.0; } },
-      { "tracker_walk_distance", [](TrackerParams& p) { p.walk_distance = std::nan(""); } } });
 }
 
 namespace {
@@ -2019,10 +2002,10 @@ Track comeOutOfAShadow(const TrackerParams& params, int scans, std::uint64_t* tu
 TEST(Tracker, SecondAxesTurnTheBoxOfACarWhoseCornerCameFirst)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.second_axes);
-  ASSERT_DOUBLE_EQ(p.second_axes_round, 0.4);
-  ASSERT_DOUBLE_EQ(p.second_axes_elongation, 0.5);
-  ASSERT_DOUBLE_EQ(p.second_axes_growth, 1.5);
+  ASSERT_TRUE(p.steps.second_axes);
+  ASSERT_DOUBLE_EQ(kSecondAxesRound, 0.4);
+  ASSERT_DOUBLE_EQ(kSecondAxesElongation, 0.5);
+  ASSERT_DOUBLE_EQ(kSecondAxesGrowth, 1.5);
   std::uint64_t turned = 0;
   const Track second = comeOutOfAShadow(p, 2, &turned);
   ASSERT_EQ(second.hits, 2);
@@ -2040,7 +2023,7 @@ TEST(Tracker, SecondAxesTurnTheBoxOfACarWhoseCornerCameFirst)
   EXPECT_EQ(tracks, 1u);
   EXPECT_EQ(with.hits, 5);
   TrackerParams off = p;
-  off.second_axes = false;
+  off.steps.second_axes = false;
   std::uint64_t off_turned = 0;
   const Track without = comeOutOfAShadow(off, 5, &off_turned);
   ASSERT_GT(without.id, 0u);
@@ -2064,24 +2047,6 @@ TEST(Tracker, SecondAxesLeaveABoxWithAnAxisOrAClusterWithout)
   EXPECT_TRUE(keeps(p, kCornerYaw, kCornerLength, kCornerWidth, 1.6, 10.4)) << "a 3.15 × 1.6 m side has none";
   EXPECT_TRUE(keeps(p, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 8.8)) << "1.55 m: not longer than 1.5 × 1.1 m";
   EXPECT_TRUE(keeps(p, 0.05, kCornerLength, kCornerWidth, 0.08, 10.4)) << "within 6° of the side's axes";
-  TrackerParams rounder = p;
-  rounder.second_axes_round = 0.5;
-  EXPECT_TRUE(keeps(rounder, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 10.4)) << "0.53 / 1.1 < 0.5";
-  TrackerParams growth = p;
-  growth.second_axes_growth = 3.0;
-  EXPECT_TRUE(keeps(growth, kCornerYaw, kCornerLength, kCornerWidth, 0.08, 10.4)) << "3.15 m < 3 × 1.1 m";
-}
-
-TEST(Tracker, SecondAxesParametersAreValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_second_axes_round", [](TrackerParams& p) { p.second_axes_round = -0.1; } },
-      { "tracker_second_axes_round", [](TrackerParams& p) { p.second_axes_round = 1.5; } },
-      { "tracker_second_axes_round", [](TrackerParams& p) { p.second_axes_round = std::nan(""); } },
-      { "tracker_second_axes_elongation", [](TrackerParams& p) { p.second_axes_elongation = 0.0; } },
-      { "tracker_second_axes_elongation", [](TrackerParams& p) { p.second_axes_elongation = 1.5; } },
-      { "tracker_second_axes_growth", [](TrackerParams& p) { p.second_axes_growth = 0.5; } },
-      { "tracker_second_axes_growth", [](TrackerParams& p) { p.second_axes_growth = std::nan(""); } } });
 }
 
 namespace {
@@ -2119,11 +2084,11 @@ Tracker throughAGap(const TrackerParams& params, int scans, double gap_speed, bo
 TEST(Tracker, HiddenEndsKeepACarSeenThroughAGapFromMovingWithTheGap)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.hidden_ends);
-  ASSERT_DOUBLE_EQ(p.hidden_ends_sigma, 5.0);
-  p.free_space_check = false;  // no ScanGrid here: the speed alone decides
+  ASSERT_TRUE(p.steps.hidden_ends);
+  ASSERT_DOUBLE_EQ(kHiddenEndsSigma, 5.0);
+  p.steps.free_space_check = false;  // no ScanGrid here: the speed alone decides
   TrackerParams off = p;
-  off.hidden_ends = false;
+  off.steps.hidden_ends = false;
   const Tracker without = throughAGap(off, 8, -2.0, false);
   ASSERT_EQ(without.tracks().size(), 1u);
   EXPECT_EQ(without.tracks()[0].motion, TrackMotion::kMoving) << "the gap's drift, taken for the car's motion";
@@ -2140,9 +2105,9 @@ TEST(Tracker, HiddenEndsKeepACarSeenThroughAGapFromMovingWithTheGap)
 TEST(Tracker, HiddenEndsLeaveAMovingTrackAndAViewWithAnEnd)
 {
   TrackerParams p;
-  p.free_space_check = false;
+  p.steps.free_space_check = false;
   TrackerParams off = p;
-  off.hidden_ends = false;
+  off.steps.hidden_ends = false;
   auto same = [](const Tracker& a, const Tracker& b) {
     return a.tracks().size() == 1u && b.tracks().size() == 1u && a.tracks()[0].x == b.tracks()[0].x &&
            a.tracks()[0].P == b.tracks()[0].P;
@@ -2156,17 +2121,9 @@ TEST(Tracker, HiddenEndsLeaveAMovingTrackAndAViewWithAnEnd)
       << "one end not hidden";
 }
 
-TEST(Tracker, HiddenEndsSigmaIsValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = 0.0; } },
-      { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = 101.0; } },
-      { "tracker_hidden_ends_sigma", [](TrackerParams& p) { p.hidden_ends_sigma = std::nan(""); } } });
-}
-
 namespace {
 
-constexpr double kVehicleYaw = 30.0 * M_PI / 180.0;  // a multiple of tracker_box_fit_step (3°)
+constexpr double kVehicleYaw = 30.0 * M_PI / 180.0;  // a multiple of kBoxFitStepDeg (3°)
 constexpr double kVehicleLength = 4.5, kVehicleWidth = 1.8;
 
 /// The returns of a 4.5 × 1.8 m vehicle centred on (10, 5), heading kVehicleYaw, seen on its rear and its left side
@@ -2195,10 +2152,10 @@ Measurement onlyCluster(const std::vector<Point2>& points, const TrackerParams& 
 TEST(Tracker, BoxFitTakesTheAxesOfAVehicleSeenOnItsRearAndSide)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.box_fit);
-  ASSERT_DOUBLE_EQ(p.box_fit_step, 3.0);
-  ASSERT_DOUBLE_EQ(p.box_fit_closeness, 0.05);
-  ASSERT_DOUBLE_EQ(p.box_fit_min_length, 1.5);
+  ASSERT_TRUE(p.steps.box_fit);
+  ASSERT_DOUBLE_EQ(kBoxFitStepDeg, 3.0);
+  ASSERT_DOUBLE_EQ(kBoxFitCloseness, 0.05);
+  ASSERT_DOUBLE_EQ(kBoxFitMinLength, 1.5);
   const Measurement fitted = onlyCluster(rearAndSide(), p);
   EXPECT_TRUE(fitted.fitted);
   EXPECT_NEAR(fitted.yaw, kVehicleYaw, 1e-12) << "the rectangle every return lies on";
@@ -2207,7 +2164,7 @@ TEST(Tracker, BoxFitTakesTheAxesOfAVehicleSeenOnItsRearAndSide)
   // The principal axes of the L lie between its two faces (11.4° off, towards the rear): its box is askew and
   // longer than the vehicle.
   TrackerParams off = p;
-  off.box_fit = false;
+  off.steps.box_fit = false;
   const Measurement principal = onlyCluster(rearAndSide(), off);
   EXPECT_FALSE(principal.fitted);
   EXPECT_GT(std::abs(std::remainder(principal.yaw - kVehicleYaw, M_PI)), 10.0 * M_PI / 180.0);
@@ -2230,34 +2187,18 @@ TEST(Tracker, BoxFitLeavesAPedestrianAndAClusterWhoseAxesAreItsBox)
 {
   TrackerParams p;
   TrackerParams off = p;
-  off.box_fit = false;
+  off.steps.box_fit = false;
   auto same = [](const Measurement& a, const Measurement& b) {
     return a.yaw == b.yaw && a.length == b.length && a.width == b.width && a.lo_u == b.lo_u && a.hi_v == b.hi_v &&
            a.covariance == b.covariance && !a.fitted && !b.fitted;
   };
-  // A 0.6 × 0.5 m L: shorter than box_fit_min_length along its principal axis, it keeps them, bit for bit.
+  // A 0.6 × 0.5 m L: shorter than kBoxFitMinLength along its principal axis, it keeps them, bit for bit.
   EXPECT_TRUE(same(onlyCluster(rearAndSide(0.6, 0.5), p), onlyCluster(rearAndSide(0.6, 0.5), off)));
-  TrackerParams shorter = p;
-  shorter.box_fit_min_length = 0.5;
-  EXPECT_TRUE(onlyCluster(rearAndSide(0.6, 0.5), shorter).fitted) << "and is fitted once the limit is below it";
   // A straight side: its principal axis is its rectangle's, within a step.
   const Measurement side = onlyCluster(rearAndSide(kVehicleLength, 0.0), p);
   EXPECT_FALSE(side.fitted);
   EXPECT_NEAR(side.yaw, kVehicleYaw, 1e-9);
   EXPECT_NEAR(side.length, kVehicleLength, 1e-9);
-}
-
-TEST(Tracker, BoxFitParametersAreValidatedByName)
-{
-  expectRefusedByName({
-      { "tracker_box_fit_step", [](TrackerParams& p) { p.box_fit_step = 0.0; } },
-      { "tracker_box_fit_step", [](TrackerParams& p) { p.box_fit_step = 46.0; } },
-      { "tracker_box_fit_step", [](TrackerParams& p) { p.box_fit_step = std::nan(""); } },
-      { "tracker_box_fit_closeness", [](TrackerParams& p) { p.box_fit_closeness = 0.0; } },
-      { "tracker_box_fit_closeness", [](TrackerParams& p) { p.box_fit_closeness = 1.5; } },
-      { "tracker_box_fit_min_length", [](TrackerParams& p) { p.box_fit_min_length = -0.1; } },
-      { "tracker_box_fit_min_length", [](TrackerParams& p) { p.box_fit_min_length = 19.0; } },
-      { "tracker_box_fit_min_length", [](TrackerParams& p) { p.box_fit_min_length = std::nan(""); } } });
 }
 
 namespace {
@@ -2331,10 +2272,10 @@ Tracker carComingOut(const TrackerParams& params, int scans, double turn = 0.0)
 TEST(Tracker, OpenAnchorFollowsALongVehicleThatBrakes)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.open_anchor);
-  p.free_space_check = false;  // no ScanGrid here: the speed alone decides
+  ASSERT_TRUE(p.steps.open_anchor);
+  p.steps.free_space_check = false;  // no ScanGrid here: the speed alone decides
   TrackerParams off = p;
-  off.open_anchor = false;
+  off.steps.open_anchor = false;
   double speed = 0.0;
   const Tracker with = busThatBrakes(p, 20, true, speed);
   const Tracker without = busThatBrakes(off, 20, true, speed);
@@ -2352,9 +2293,9 @@ TEST(Tracker, OpenAnchorFollowsALongVehicleThatBrakes)
 TEST(Tracker, OpenAnchorLeavesAClusterWhoseAnchoringEndIsNotOpen)
 {
   TrackerParams p;
-  p.free_space_check = false;
+  p.steps.free_space_check = false;
   TrackerParams off = p;
-  off.open_anchor = false;
+  off.steps.open_anchor = false;
   double speed = 0.0;
   const Tracker with = busThatBrakes(p, 20, false, speed);
   const Tracker without = busThatBrakes(off, 20, false, speed);
@@ -2368,12 +2309,12 @@ TEST(Tracker, OpenAnchorLeavesAClusterWhoseAnchoringEndIsNotOpen)
 TEST(Tracker, FarGrowthFollowsACarComingOutFromBehindAnOccluder)
 {
   TrackerParams p;
-  ASSERT_TRUE(p.open_anchor);
-  ASSERT_TRUE(p.far_growth);
+  ASSERT_TRUE(p.steps.open_anchor);
+  ASSERT_TRUE(p.steps.far_growth);
   ASSERT_EQ(p.confirm_hits, 3);
-  p.free_space_check = false;
+  p.steps.free_space_check = false;
   TrackerParams off = p;
-  off.far_growth = false;
+  off.steps.far_growth = false;
   // Its velocity when it is confirmed, the first one reported.
   const Tracker with = carComingOut(p, 3);
   const Tracker without = carComingOut(off, 3);
@@ -2387,16 +2328,16 @@ TEST(Tracker, FarGrowthFollowsACarComingOutFromBehindAnOccluder)
   EXPECT_EQ(with.counts().open_anchor, 2u);
   EXPECT_EQ(without.counts().far_growth, 0u);
   TrackerParams no_anchor = p;
-  no_anchor.open_anchor = false;
+  no_anchor.steps.open_anchor = false;
   EXPECT_EQ(carComingOut(no_anchor, 3).counts().far_growth, 0u) << "far growth is a part of step open anchor";
 }
 
 TEST(Tracker, FarGrowthLeavesAClusterTurnedOffTheBoxAxes)
 {
   TrackerParams p;
-  p.free_space_check = false;
+  p.steps.free_space_check = false;
   TrackerParams off = p;
-  off.far_growth = false;
+  off.steps.far_growth = false;
   const double turn = 0.2;  // rad: more than the 0.1 rad within which two axes are the same
   const Tracker with = carComingOut(p, 4, turn);
   const Tracker without = carComingOut(off, 4, turn);
@@ -2431,9 +2372,9 @@ TEST(Tracker, ManoeuvresLetTheReportedVelocityFollowABrakingCar)
     return error / n;
   };
   TrackerParams on;
-  ASSERT_GT(on.manoeuvre_jerk_sigma, 0.0);
+  ASSERT_TRUE(on.steps.manoeuvres);
   TrackerParams off = on;
-  off.manoeuvre_jerk_sigma = 0.0;
+  off.steps.manoeuvres = false;
   const double with = lag(on), without = lag(off);
   EXPECT_GT(without, 0.5) << "the constant-velocity filter lags";
   EXPECT_LT(with, 0.7 * without) << "the IMM follows the braking";
@@ -2441,7 +2382,8 @@ TEST(Tracker, ManoeuvresLetTheReportedVelocityFollowABrakingCar)
 
 TEST(Tracker, ManoeuvreParameterIsValidatedByName)
 {
-  expectRefusedByName({ { "tracker_manoeuvre_jerk_sigma", [](TrackerParams& p) { p.manoeuvre_jerk_sigma = -1.0; } },
+  expectRefusedByName({ { "tracker_manoeuvre_jerk_sigma", [](TrackerParams& p) { p.manoeuvre_jerk_sigma = 0.0; } },
+                        { "tracker_manoeuvre_jerk_sigma", [](TrackerParams& p) { p.manoeuvre_jerk_sigma = -1.0; } },
                         { "tracker_manoeuvre_jerk_sigma", [](TrackerParams& p) { p.manoeuvre_jerk_sigma = 101.0; } },
                         { "tracker_manoeuvre_jerk_sigma",
                           [](TrackerParams& p) { p.manoeuvre_jerk_sigma = std::nan(""); } } });

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <vector>
 #include <set>
 #include <string>
 #include <type_traits>
@@ -150,8 +151,11 @@ std::map<std::string, std::string> valuesOf(Params p)
 {
   std::map<std::string, std::string> out;
   core::forEachParam(p, [&](const std::string& name, auto& v, const core::ParamDoc&) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>)
+    using T = std::decay_t<decltype(v)>;
+    if constexpr (std::is_same_v<T, std::string>)
       out[name] = v;
+    else if constexpr (std::is_same_v<T, std::vector<std::string>>)
+      for (const std::string& x : v) out[name] += x + ";";
     else
       out[name] = std::to_string(static_cast<double>(v));
   });

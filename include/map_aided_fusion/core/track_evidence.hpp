@@ -34,8 +34,8 @@ std::vector<ObjectBox> reportedBoxes(const Tracker& tracker);
  * @brief The cells of @p geometry holding the returns of the last scan of every reported track associated in that
  *        scan (its measurement's and, with step duplicates, its fragments', Track::fragments), with the track's
  *        motion and β; with step track box also the cells whose centre lies in its measurement's box (interior
- *        cells): a moving vehicle's box extended by step hidden length and grown across by evidence_box_margin on
- *        each side (step box margin), a small mover's by step small box. Empty when evidence_weight is 0 or the
+ *        cells): a moving vehicle's box extended by step hidden length and grown across by kBoxMargin on
+ *        each side (step box margin), a small mover's by step small box. Empty when step track evidence is off or the
  *        tracker was given measurements without returns.
  */
 std::vector<CellMotion> trackEvidence(const Tracker& tracker, const GridGeometry& geometry);
@@ -54,7 +54,7 @@ float priorBetPBuilding(const PriorWindow& prior, std::size_t i);
 /**
  * @brief One scan of tracking after @p grid's update(): flags the returns on static background (backgroundFlags():
  *        the grid's counter ζ above background_zeta or, with step building background, its BetP(C) above
- *        background_building; beyond the grid's window, where it has neither, @p prior's own BetP(C),
+ *        kBuildingBackgroundBetP; beyond the grid's window, where it has neither, @p prior's own BetP(C),
  *        priorBetPBuilding(), when given), updates @p tracker with the scan's ScanGrid @p scan (vehicle frame; the
  *        free space of step free-space check, nullptr: none), and applies its evidence to @p grid
  *        (MapGrid::applyTrackedMotion()). @p background is the caller's buffer, kept from scan to scan; @p prior is

@@ -19,15 +19,24 @@
 namespace map_aided_fusion {
 namespace core {
 
-/// TrackerParams' common_motion_* fields and common_turn.
+/// The common motion's numbers (steps common motion and common turn; fixed, not parameters): at least 20 confirmed
+/// tracks seen in the scan, more than half of them within 2 σ(speed) of the motion, which is no faster than 2 m/s and
+/// turns no faster than 0.05 rad/s (KITTI 00's drifting poses: 1.0 to 1.6 m/s, a heading drift of about 0.03 rad/s).
+constexpr int kCommonMotionMinTracks = 20;
+constexpr double kCommonMotionShare = 0.5;
+constexpr double kCommonMotionSigmas = 2.0;
+constexpr double kCommonMotionMaxSpeed = 2.0;
+constexpr double kCommonMotionMaxTurnRate = 0.05;
+
+/// What the fit reads: the constants above and TrackerSteps::common_turn.
 struct CommonMotionParams
 {
-  int min_tracks = 20;         ///< tracks seen in the scan, at least
-  double share = 0.5;          ///< in (0, 1]: more than this share must agree
-  double sigmas = 2.0;         ///< σ(speed) of a track from the motion that still agrees with it
-  double max_speed = 2.0;      ///< m/s: a faster common motion is traffic, not a drift
-  bool turn = true;            ///< fit the turn rate too (with a sensor position)
-  double max_turn_rate = 0.05;  ///< rad/s: a faster turn is not a drift
+  int min_tracks = kCommonMotionMinTracks;        ///< tracks seen in the scan, at least
+  double share = kCommonMotionShare;              ///< in (0, 1]: more than this share must agree
+  double sigmas = kCommonMotionSigmas;            ///< σ(speed) of a track from the motion that still agrees with it
+  double max_speed = kCommonMotionMaxSpeed;       ///< m/s: a faster common motion is traffic, not a drift
+  bool turn = true;                               ///< fit the turn rate too (with a sensor position)
+  double max_turn_rate = kCommonMotionMaxTurnRate;  ///< rad/s: a faster turn is not a drift
 };
 
 /// A track seen in the scan.

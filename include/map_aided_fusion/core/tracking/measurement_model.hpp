@@ -42,7 +42,7 @@ struct Measurement
   static constexpr std::uint8_t kLowU = 1, kHighU = 2, kLowV = 4, kHighV = 8;
   std::vector<int> returns;  ///< clusterReturns(): indices of its returns in the points clustered
   bool split = false;  ///< step background split: a piece of the returns off background of a cluster too large
-  bool fitted = false;  ///< step box fit: its axes are more than box_fit_step off its principal axes
+  bool fitted = false;  ///< step box fit: its axes are more than BoxFitParams::step_deg off its principal axes
 };
 
 /// The box of a measurement seen along an axis: its interval relative to the centroid, and whether its low end is the
@@ -67,13 +67,17 @@ constexpr double kMinAxesTurn = 0.1;
  */
 AxisView viewAlong(const Measurement& m, const Eigen::Vector2d& axis);
 
-/// What the measurement model reads (TrackerParams' fields of the same names).
+/// m: the standard deviation step hidden ends adds along the axis of a cluster seen through a gap (fixed: the
+/// length of a car seen through the gap between two parked cars, so that its views tell a track nothing there).
+constexpr double kHiddenEndsSigma = 5.0;
+
+/// What the measurement model reads (TrackerParams' sigmas, TrackerSteps' switches of the same names).
 struct MeasurementModelParams
 {
   double measurement_sigma = 0.15;  ///< m, standard deviation of a compact cluster's centroid
   double extent_sigma = 0.1;        ///< m of standard deviation per metre of extent
   bool hidden_ends = true;          ///< step hidden ends
-  double hidden_ends_sigma = 5.0;   ///< m
+  double hidden_ends_sigma = kHiddenEndsSigma;  ///< m
   bool open_anchor = true;          ///< step open anchor
   bool far_growth = true;           ///< step far growth
 };

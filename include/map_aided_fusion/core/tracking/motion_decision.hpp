@@ -20,12 +20,16 @@ enum class TrackMotion : unsigned char
   kStopped,  ///< speed + motion_sigmas · σ below stopped_speed for stopped_time
 };
 
+/// While the free-space check runs, free space has shown the motion too, so the speed need clear moving_speed by
+/// this many standard deviations only, instead of motion_sigmas (which still decides without a ScanGrid).
+constexpr double kFreeSpaceMotionSigmas = 0.5;
+
 /// What the decision reads (TrackerParams' fields of the same names).
 struct MotionDecisionParams
 {
   double moving_speed = 0.5;               ///< m/s
   double motion_sigmas = 1.5;              ///< standard deviations the speed must clear
-  double free_space_motion_sigmas = 0.5;   ///< … while the free-space check runs
+  double free_space_motion_sigmas = kFreeSpaceMotionSigmas;  ///< … while the free-space check runs
   double stopped_speed = 0.8;              ///< m/s
   double stopped_time = 1.0;               ///< s
 };

@@ -18,14 +18,21 @@
 namespace map_aided_fusion {
 namespace core {
 
-/// What the rectangle fit reads (TrackerParams' box_fit_* and max_object_length).
+/// The rectangle fit's numbers (step box fit; fixed, not parameters): rectangles every 3° in [0°, 90°), a return
+/// within 5 cm of an edge (a lidar's range noise) scoring as if on it, and clusters shorter than 1.5 m (a
+/// pedestrian's returns, which have no edges to fit) keeping their principal axes.
+constexpr double kBoxFitStepDeg = 3.0;
+constexpr double kBoxFitCloseness = 0.05;
+constexpr double kBoxFitMinLength = 1.5;
+
+/// What the rectangle fit reads: the constants above, TrackerSteps::box_fit and TrackerParams::max_object_length.
 struct BoxFitParams
 {
   bool enabled = true;      ///< off: the principal axis only
-  double min_length = 1.5;  ///< m: a cluster shorter than this along its principal axis keeps that axis
+  double min_length = kBoxFitMinLength;  ///< m: a cluster shorter than this along its principal axis keeps that axis
   double max_length = 18.0;  ///< m: a cluster longer than √2 · this along its principal axis is no object: not fitted
-  double step_deg = 3.0;    ///< deg: the headings tried, in (0, 45]
-  double closeness = 0.05;  ///< m: distances to an edge below this score as this
+  double step_deg = kBoxFitStepDeg;     ///< deg: the headings tried, in (0, 45]
+  double closeness = kBoxFitCloseness;  ///< m: distances to an edge below this score as this
 };
 
 /// A cluster's rectangle: its axes and its extents along them, from the returns' mean.
