@@ -87,8 +87,12 @@ TEST(ReplayVariants, TheConfiguredThePaperTheirAblationsAndOneRowPerAddedStep)
                                      "single_rate", "no_counter" };
   for (const core::AddedStep& step : core::addedSteps())
     if (step.enabled(configured)) expected.push_back("default_without_" + std::string(step.name));
-  expected.push_back("default_with_ground_zones");  // the ground model that is not the default's
+  expected.push_back("default_with_motion_spreading");  // the step off by default
+  expected.push_back("default_with_ground_zones");      // the ground model that is not the default's
   EXPECT_EQ(names, expected);
+  const VariantSpec& spreading = all[all.size() - 2];
+  EXPECT_EQ(spreading.profile.map_grid.motion_share, core::kMotionSpreadingShare);
+  EXPECT_EQ(configured.map_grid.motion_share, 0.0) << "off by default";
   EXPECT_EQ(all.back().profile.scan_grid.groundModel(), core::GroundModel::kZones);
   core::Profile zones = configured;
   zones.scan_grid.ground_model = "zones";
@@ -105,7 +109,7 @@ TEST(ReplayVariants, TheConfiguredThePaperTheirAblationsAndOneRowPerAddedStep)
     {
       const std::string step = v.name.substr(std::string("default_without_").size());
       for (const core::AddedStep& s : core::addedSteps())
-        EXPECT_EQ(s.enabled(v.profile), s.name != step) << v.name << " and " << s.name;
+        EXPECT_EQ(s.enabled(v.profile), s.enabled(configured) && s.name != step) << v.name << " and " << s.name;
     }
 }
 
