@@ -197,7 +197,7 @@ ManoeuvreModel Tracker::manoeuvreModel() const
 
 void Tracker::predict(Track& t, double dt) const
 {
-  if (!manoeuvres())
+  if (!t.manoeuvres)
   {
     predictConstantVelocity(t.x, t.P, dt, params_.acceleration_sigma);
     return;
@@ -227,7 +227,7 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
   bool long_box = false;
   const Point2 ref = referencePoint(t, m);
   const Eigen::Matrix2d r = anchorCovariance(trackView(t), m, measurement_model_);
-  if (manoeuvres())
+  if (t.manoeuvres)
   {
     correctImm(t.imm, Eigen::Vector2d(ref.x, ref.y), r);
     t.imm.combine(t.x, t.P);
@@ -274,7 +274,7 @@ bool Tracker::correct(Track& t, const Measurement& m, double stamp) const
     t.extent_width = std::max(t.extent_width, m.width);
   }
   // The box's bookkeeping moved the followed point on the object: every model follows it.
-  if (manoeuvres()) t.imm.shiftPosition(t.x.head<2>() - corrected);
+  if (t.manoeuvres) t.imm.shiftPosition(t.x.head<2>() - corrected);
   ++t.hits;
   ++t.consecutive_hits;
   if (background_known_) t.background_unchecked = false;
@@ -654,7 +654,8 @@ Track Tracker::newTrack(const Measurement& z, int measurement, double stamp)
   t.P.setZero();
   t.P.topLeftCorner<2, 2>() = z.covariance;
   t.P(2, 2) = t.P(3, 3) = kInitialSpeedSigma * kInitialSpeedSigma;
-  t.manoeuvres = manoeuvres();
+  // Step manoeuvres, per class: a walker (a first cluster of a pedestrian's size) keeps the constant-velocity model.
+  t.manoeuvres = manoeuvres() && !(z.length <= params_.pedestrian_size && z.width <= params_.pedestrian_size);
   if (t.manoeuvres)
     t.imm.reset(t.x, t.P, params_.acceleration_sigma * params_.acceleration_sigma, manoeuvreModel().stationaryManoeuvre());
   t.yaw = t.extent_yaw = z.yaw;

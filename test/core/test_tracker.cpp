@@ -2351,6 +2351,29 @@ TEST(Tracker, FarGrowthLeavesAClusterTurnedOffTheBoxAxes)
 
 // Step manoeuvres: a car at 10 m/s that brakes at 4 m/s² for 2 s (the default scenario's bus pulling in lagged its
 // braking by about 1 m/s for 2 s). Its reported velocity follows with the step; the constant-velocity filter lags.
+// Step manoeuvres per class: the IMM for a vehicle, the constant-velocity model alone for a track born of a
+// pedestrian's size (and for every track with the step off).
+TEST(Tracker, ManoeuvresRunTheImmForVehiclesAndNotForWalkers)
+{
+  auto born = [](const TrackerParams& p, double length, double width) {
+    Tracker tracker(p);
+    const std::vector<float> xy = flatten(boxOutline(10.0, 5.0, 0.0, length, width));
+    tracker.update(0.0, Pose2{}, ObstaclePoints{ xy.data(), xy.size() / 2 });
+    EXPECT_EQ(tracker.tracks().size(), 1u);
+    return tracker.tracks().empty() ? Track{} : tracker.tracks()[0];
+  };
+  TrackerParams p;
+  p.min_cluster_points = 4;
+  ASSERT_DOUBLE_EQ(p.pedestrian_size, 1.0);
+  EXPECT_TRUE(born(p, 4.0, 2.0).manoeuvres) << "a car";
+  const Track walker = born(p, 0.6, 0.5);
+  EXPECT_LE(std::max(walker.length, walker.width), p.pedestrian_size);
+  EXPECT_FALSE(walker.manoeuvres) << "a pedestrian-sized cluster";
+  TrackerParams off = p;
+  off.steps.manoeuvres = false;
+  EXPECT_FALSE(born(off, 4.0, 2.0).manoeuvres);
+}
+
 TEST(Tracker, ManoeuvresLetTheReportedVelocityFollowABrakingCar)
 {
   auto lag = [](const TrackerParams& p) {

@@ -70,7 +70,7 @@ struct Track
   Eigen::Matrix4d P = Eigen::Matrix4d::Identity();
   /// Step manoeuvres: the two models whose mixture x and P are (used when manoeuvres is set).
   ImmState imm;
-  bool manoeuvres = false;
+  bool manoeuvres = false;  ///< the IMM runs (step manoeuvres, and a first cluster larger than a pedestrian)
   double yaw = 0.0, length = 0.0, width = 0.0;  ///< of the last associated cluster
   /// The object's box: heading fixed by its first cluster, extents the largest seen along the box's axes.
   double extent_yaw = 0.0, extent_length = 0.0, extent_width = 0.0;

@@ -155,7 +155,9 @@ struct TrackerSteps
   bool far_growth = true;
   /// "manoeuvres" (core/tracking/motion_model.hpp, ImmState): the motion model is an interacting multiple model of
   /// the constant-velocity model and a constant-acceleration one (white-noise jerk manoeuvre_jerk_sigma), which
-  /// follows braking, pulling away and turning; off: the constant-velocity model alone.
+  /// follows braking, pulling away and turning; off: the constant-velocity model alone. Per class, as the field's
+  /// trackers choose their motion models: a track whose first cluster is at most pedestrian_size long and wide (a
+  /// walker) keeps the constant-velocity model alone.
   bool manoeuvres = true;
   /// "common motion": a pose that drifts (a localisation's slow error) moves the whole static world in the map
   /// frame, and the track of every static object takes that drift as its velocity (KITTI 00's first sweeps: 1.0 to
