@@ -323,9 +323,9 @@ void Tracker::decideMotion(Track& t, double stamp) const
 
 bool Tracker::smallWalker(const Track& t) const
 {
-  const double small = params_.steps.small_free_space ? params_.pedestrian_size : 0.0, least = kSmallMinExtent;
-  const bool thick = t.extent_length >= least && t.extent_width >= least;
-  return small > 0.0 && t.extent_length <= small && t.extent_width <= small && thick &&
+  const double small = params_.pedestrian_size;
+  const bool thick = t.extent_length >= kSmallMinExtent && t.extent_width >= kSmallMinExtent;
+  return params_.steps.small_free_space && t.extent_length <= small && t.extent_width <= small && thick &&
          t.speed() <= kWalkingMaxSpeed;
 }
 
