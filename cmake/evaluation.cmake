@@ -1,6 +1,6 @@
 # Evaluation: ROS-free metrics library, the `evaluate` tool (reads bags) and its tests.
-add_library(map_aided_fusion_eval src/eval/metrics.cpp src/eval/point_labels.cpp src/eval/movers.cpp
-  src/eval/clear_mot.cpp)
+add_library(map_aided_fusion_eval src/eval/metrics.cpp src/eval/point_labels.cpp src/eval/scan_evidence.cpp
+  src/eval/movers.cpp src/eval/clear_mot.cpp)
 target_link_libraries(map_aided_fusion_eval map_aided_fusion_core)
 target_include_directories(map_aided_fusion_eval PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 
@@ -10,7 +10,7 @@ install(TARGETS map_aided_fusion_eval
 
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_metrics test/eval/test_metrics.cpp test/eval/test_movers.cpp test/eval/test_clear_mot.cpp
-    test/eval/test_point_labels.cpp
+    test/eval/test_point_labels.cpp test/eval/test_scan_evidence.cpp
     test/test_main.cpp)
   target_link_libraries(test_metrics map_aided_fusion_eval)
 endif()

@@ -161,6 +161,39 @@ def real_table(real, pooled):
     return "\n".join(lines) + "\n"
 
 
+# Labelled-ground cells not decided F, by what the sweep's scan gave them (`evaluate`, eval/scan_evidence.hpp).
+GROUND_LOSS_COLUMNS = [
+    ("decided F", lambda v: counted(v, "ground_f_cells", "ground_cells")),
+    ("not F: scan free", lambda v: counted(v, "ground_not_f_free", "ground_cells_with_evidence")),
+    ("not F: scan occupied", lambda v: counted(v, "ground_not_f_occupied", "ground_cells_with_evidence")),
+    ("not F: free cleared near an obstacle", lambda v: counted(v, "ground_not_f_cleared", "ground_cells_with_evidence")),
+    ("not F: beyond the sector's free space", lambda v: counted(v, "ground_not_f_unreached",
+                                                                "ground_cells_with_evidence")),
+    ("not F: ambiguous return", lambda v: counted(v, "ground_not_f_ambiguous", "ground_cells_with_evidence")),
+]
+# The variants whose ground handling differs from the default's, in the pooled rows of that table.
+GROUND_LOSS_VARIANTS = ("default", "paper", "default_with_ground_cells_free", "default_without_obstacle_clearance",
+                        "default_without_ambiguous_unknown", "default_without_ground_consensus",
+                        "default_with_ground_zones")
+
+
+def ground_loss_table(real, pooled):
+    """Per labelled real sequence (default, paper) and pooled, the labelled-ground cells decided F and why the others
+    are not: what the sweep's scan gave them."""
+    lines = ["| sequence | variant | " + " | ".join(c for c, _ in GROUND_LOSS_COLUMNS) + " |",
+             "| --- | --- | " + " | ".join("---:" for _ in GROUND_LOSS_COLUMNS) + " |"]
+    for name, title in REAL_SEQUENCES:
+        for variant in ("default", "paper"):
+            if name in real and variant in real[name]:
+                c = {"counts": real_counts(real[name][variant])}
+                lines.append(f"| {title} | {variant} | " + " | ".join(f(c) for _, f in GROUND_LOSS_COLUMNS) + " |")
+    for variant in GROUND_LOSS_VARIANTS:
+        if variant in pooled:
+            lines.append(f"| **pooled** ({pooled[variant]['sequences']} drives) | {variant} | " +
+                         " | ".join(f(pooled[variant]) for _, f in GROUND_LOSS_COLUMNS) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def real_variants_table(pooled):
     """Every variant (the default, each step off, the paper and its ablations) on the pooled real sequences."""
     lines = ["| variant | " + " | ".join(c for c, _ in REAL_COLUMNS) + " |",
@@ -310,6 +343,9 @@ def main():
         if real_pooled:
             parts += ["\nEvery variant on the pooled real sequences (a step stays on by default only where it wins "
                       "here and makes no sequence worse; doc/steps.md):\n\n", real_variants_table(real_pooled)]
+            parts += ["\nLabelled-ground cells not decided F, by what the sweep's scan gave them (doc/evaluation.md, "
+                      "\"Why ground is not decided F\"); with the decided ones they add up to 1:\n\n",
+                      ground_loss_table(real, real_pooled)]
         if "kitti_00" in real:
             parts += ["\nKITTI 00's motorcyclist (GPS/INS poses):\n\n", table(real["kitti_00"], KITTI_COLUMNS)]
     if tracking:

@@ -29,6 +29,9 @@ const std::vector<AddedStep>& addedSteps()
     { "ambiguous_unknown", "a ScanGrid cell holding a return neither ground nor obstacle gets no free mass",
       [](const Profile& p) { return p.scan_grid.ambiguous_unknown; },
       [](Profile& p) { p.scan_grid.ambiguous_unknown = false; } },
+    { "ground_cells_free", "a ScanGrid cell holding a ground return is free, also beyond its sector's nearest obstacle",
+      [](const Profile& p) { return p.scan_grid.ground_cells_free; },
+      [](Profile& p) { p.scan_grid.ground_cells_free = false; } },
     { "ground_consensus", "a return one fitted ground model calls ground and the other obstacle bounds free space, no mass "
                           "(inert with the flat model)",
       [](const Profile& p) { return p.scan_grid.ground_consensus; },

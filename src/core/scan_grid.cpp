@@ -146,6 +146,8 @@ struct PointPass
   const GroundPlaneFitter* second;
   // Step "ambiguous unknown": per cell, set when it holds a return neither ground nor obstacle (nullptr when off).
   std::uint8_t* ambiguous;
+  // Step "ground cells free": per cell, set when it holds a ground return (nullptr when off).
+  std::uint8_t* ground_seen;
   // recordReturnClasses(): per point its class, per obstacle and valid return its point (nullptr when off).
   ReturnClass* point_class;
   std::uint32_t* obstacle_point;
@@ -157,12 +159,15 @@ struct PointPass
   }
 
   /// Flags the cell of a return at (dx, dy) from the sensor as holding an ambiguous return (any thread).
-  void markAmbiguous(float dx, float dy) const
+  void markAmbiguous(float dx, float dy) const { markCell(ambiguous, dx, dy); }
+
+  /// Sets @p flags' entry of the cell of a return at (dx, dy) from the sensor, when it is on the grid (any thread).
+  void markCell(std::uint8_t* flags, float dx, float dy) const
   {
     const float fx = cx0 + dx * inv_res;
     const float fy = cy0 + dy * inv_res;
     if ((fx >= 0.0f) & (fy >= 0.0f) & (fx < fwidth) & (fy < fheight))
-      __atomic_store_n(ambiguous + static_cast<int>(fy) * width + static_cast<int>(fx), std::uint8_t{ 1 },
+      __atomic_store_n(flags + static_cast<int>(fy) * width + static_cast<int>(fx), std::uint8_t{ 1 },
                        __ATOMIC_RELAXED);
   }
 
@@ -234,6 +239,7 @@ struct PointPass
       const std::size_t k = out.first + out.ground++;
       ground_sector[k] = static_cast<std::uint32_t>(sectorIndex(dx, dy, sector_scale, num_sectors));
       ground_range2[k] = r2;
+      if (ground_seen) markCell(ground_seen, dx, dy);
     }
     else if (h < obstacle_min)
     {
@@ -393,6 +399,13 @@ void ScanGridBuilder::prepareStepBuffers(std::size_t n_points, bool fitted)
     parallel_->forRange(ambiguous_.size(), kFillChunk,
                         [amb](std::size_t i0, std::size_t i1) { std::fill(amb + i0, amb + i1, std::uint8_t{ 0 }); });
   }
+  if (params_.ground_cells_free)
+  {
+    ground_seen_.resize(geometry_.numCells());
+    std::uint8_t* const seen = ground_seen_.data();
+    parallel_->forRange(ground_seen_.size(), kFillChunk,
+                        [seen](std::size_t i0, std::size_t i1) { std::fill(seen + i0, seen + i1, std::uint8_t{ 0 }); });
+  }
   if (!record_classes_)
   {
     return_classes_.clear();
@@ -423,6 +436,35 @@ std::size_t ScanGridBuilder::clearAmbiguousFree(float* m_f, float* m_omega) cons
   std::size_t cleared = 0;
   for (const std::size_t c : chunk_cleared) cleared += c;
   return cleared;
+}
+
+std::size_t ScanGridBuilder::fillGroundCells(float* m_f, float* m_omega) const
+{
+  // A cell holding a ground return and no free mass yet (beyond its sector's nearest obstacle) is free. μ_F is that of
+  // its centre's range, as in the table; a centre outside [min_range, max_range] stays unknown, as there.
+  const std::uint8_t* const seen = ground_seen_.data();
+  const bool decay = params_.free_decay_length > 0.0;
+  const double min2 = params_.min_range * params_.min_range, max2 = params_.max_range * params_.max_range;
+  std::vector<std::size_t> chunk_filled(chunkCount(ground_seen_.size(), kFillChunk), 0);
+  parallel_->forRange(ground_seen_.size(), kFillChunk, [&](std::size_t i0, std::size_t i1) {
+    std::size_t filled = 0;
+    for (std::size_t i = i0; i < i1; ++i)
+    {
+      if (!seen[i] || m_f[i] > 0.0f) continue;
+      const Point2 c = geometry_.cellCentre(geometry_.cellOf(i));
+      const double dx = c.x - table_sensor_x_, dy = c.y - table_sensor_y_;
+      const double r2 = dx * dx + dy * dy;
+      if (r2 < min2 || r2 > max2) continue;
+      const double mu = decay ? params_.mu_free * std::exp(-std::sqrt(r2) / params_.free_decay_length) : params_.mu_free;
+      m_f[i] = static_cast<float>(mu);
+      m_omega[i] = 1.0f - m_f[i];
+      filled += m_f[i] > 0.0f;
+    }
+    chunk_filled[i0 / kFillChunk] = filled;
+  });
+  std::size_t filled = 0;
+  for (const std::size_t c : chunk_filled) filled += c;
+  return filled;
 }
 
 int ScanGridBuilder::sectorOf(double dx, double dy) const
@@ -573,6 +615,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   pass.second = consensus ? &second_ : nullptr;
   pass.valid_zone2 = consensus ? valid_zone2_.data() : nullptr;
   pass.ambiguous = params_.ambiguous_unknown ? ambiguous_.data() : nullptr;
+  pass.ground_seen = params_.ground_cells_free ? ground_seen_.data() : nullptr;
   pass.point_class = record_classes_ ? return_classes_.data() : nullptr;
   pass.obstacle_point = record_classes_ ? obstacle_point_.data() : nullptr;
   pass.valid_point = record_classes_ && planes ? valid_point_.data() : nullptr;
@@ -826,6 +869,7 @@ bool ScanGridBuilder::build(const PointCloudView& points, ScanMassGrid& grid, Sc
   });
   std::size_t free_cells = 0;
   for (const std::size_t c : sector_chunk_free_) free_cells += c;
+  if (pass.ground_seen) free_cells += fillGroundCells(m_f, m_omega);
   if (pass.ambiguous) free_cells -= clearAmbiguousFree(m_f, m_omega);
 
   const float mu_o = static_cast<float>(params_.mu_occupied);

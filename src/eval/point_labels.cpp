@@ -72,7 +72,8 @@ namespace {
 
 /// The labelled-cell and point counts of one sweep that add() did not count before this issue: ground and obstacle
 /// cells by decision, moving points by their cell's decision.
-void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPoint>& points, PointScanScore& s)
+void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPoint>& points, PointScanScore& s,
+                         const EvidenceGrid* evidence)
 {
   const core::GridGeometry& g = decision.geometry;
   const auto moving = static_cast<std::int8_t>(core::CellClass::kMoving);
@@ -94,11 +95,14 @@ void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPo
     if (lp.obstacle) obstacle.insert(i);
     if (lp.obstacle && !lp.vegetation) rigid.insert(i);
   }
+  s.has_evidence = evidence && evidence->geometry == g && evidence->cells.size() == decision.cells.size();
   for (std::size_t i : ground)
     if (!other.count(i))
     {
       ++s.ground_cells;
       s.ground_f_cells += decision.cells[i] == free;
+      if (s.has_evidence && decision.cells[i] != free)
+        ++s.ground_not_f[static_cast<std::size_t>(evidence->cells[i])];
     }
   for (std::size_t i : obstacle)
   {
@@ -116,6 +120,12 @@ void scoreCellsAndPoints(const ClassGrid& decision, const std::vector<LabelledPo
 
 void PointLabelScorer::add(double stamp, const ClassGrid& decision, const std::vector<LabelledPoint>& points,
                            bool labelled)
+{
+  add(stamp, decision, points, labelled, nullptr);
+}
+
+void PointLabelScorer::add(double stamp, const ClassGrid& decision, const std::vector<LabelledPoint>& points,
+                           bool labelled, const EvidenceGrid* evidence)
 {
   PointScanScore s;
   s.stamp = stamp;
@@ -169,7 +179,7 @@ void PointLabelScorer::add(double stamp, const ClassGrid& decision, const std::v
   }
   for (std::size_t i : static_cells)
     if (!moving_cells.count(i)) ++s.static_cells[static_cast<std::size_t>(slotOf(decision.cells[i]))];
-  scoreCellsAndPoints(decision, points, s);
+  scoreCellsAndPoints(decision, points, s, evidence);
   for (const auto& [id, cells] : instance_cells)
   {
     MovingInstance& m = instances_[id];
@@ -237,7 +247,30 @@ std::map<std::string, double> PointLabelScorer::summary() const
     m["static_cells." + std::string(core::kCellClassNames[static_cast<std::size_t>(c)])] = ratio(st[c], total_static);
   m["static_cells.unknown"] = ratio(st[kUnknownSlot], total_static);
   addCellAndPointScores(m);
+  addGroundLossScores(m);
   return m;
+}
+
+void PointLabelScorer::addGroundLossScores(std::map<std::string, double>& m) const
+{
+  double ground = 0;
+  std::array<double, kNumScanEvidence> not_f{};
+  bool any = false;
+  for (const PointScanScore& s : sweeps_)
+  {
+    if (!s.labelled || !s.has_evidence) continue;
+    any = true;
+    ground += static_cast<double>(s.ground_cells);
+    for (std::size_t e = 0; e < not_f.size(); ++e) not_f[e] += static_cast<double>(s.ground_not_f[e]);
+  }
+  if (!any) return;
+  m["counts.ground_cells_with_evidence"] = ground;
+  for (std::size_t e = 0; e < not_f.size(); ++e)
+  {
+    const std::string name(kScanEvidenceNames[e]);
+    m["ground_cells_not_f." + name] = countRatio(not_f[e], ground);
+    m["counts.ground_not_f_" + name] = not_f[e];
+  }
 }
 
 void PointLabelScorer::addCellAndPointScores(std::map<std::string, double>& m) const

@@ -60,6 +60,16 @@ std::vector<VariantSpec> variantSpecs(const core::Profile& configured, bool have
         "moving object: its open motion goes to {V}",
         p, have_prior);
   }
+  // Step ground cells free, off by default since it lost on the labelled real sequences (doc/steps.md).
+  if (!configured.scan_grid.ground_cells_free)
+  {
+    core::Profile p = configured;
+    p.scan_grid.ground_cells_free = true;
+    add("default_with_ground_cells_free",
+        "default, with the step ground_cells_free (off by default): a ScanGrid cell holding a ground return is free, "
+        "also beyond its sector's nearest obstacle",
+        p, have_prior);
+  }
   // The ground model that is not the default's: its measurement beside the default's (doc/steps.md).
   if (configured.scan_grid.groundModel() == core::GroundModel::kPlanes)
   {

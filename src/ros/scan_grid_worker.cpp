@@ -47,6 +47,7 @@ void toConfig(const core::ScanGridParams& m, ScanGridConfig& c)
   c.free_decay_length = m.free_decay_length;
   c.free_margin = m.free_margin;
   c.ambiguous_unknown = m.ambiguous_unknown;
+  c.ground_cells_free = m.ground_cells_free;
   c.ground_consensus = m.ground_consensus;
   c.deskew = m.deskew;
   c.ground_model = m.ground_model;
@@ -418,6 +419,7 @@ void ScanGridWorker::onReconfigure(ScanGridConfig& config, std::uint32_t /*level
   m.free_decay_length = config.free_decay_length;
   m.free_margin = config.free_margin;
   m.ambiguous_unknown = config.ambiguous_unknown;
+  m.ground_cells_free = config.ground_cells_free;
   m.ground_consensus = config.ground_consensus;
   m.deskew = config.deskew;
   m.ground_model = config.ground_model;

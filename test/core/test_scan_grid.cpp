@@ -874,3 +874,53 @@ TEST(ScanGrid, AmbiguousReturnsLeaveTheirCellUnknownNotFree)
   expectFree(on, 60, row);
   EXPECT_EQ(on.plane(FrameSG::kO)[on.geometry().index(56, row)], 0.0f) << "ambiguous, not occupied";
 }
+
+TEST(ScanGrid, GroundCellsFreeGivesTheCellsOfGroundReturnsBehindAnObstacleFreeMassAndNothingElse)
+{
+  ScanGridParams p = testParams();
+  p.azimuth_resolution_deg = 10.0;  // sector [0°, 10°) holds the centres of row 40 from column 43 on
+  const int row = 40;
+  // An obstacle at 6.25 m (cell 52): the sector's free space ends there. Ground returns behind it at 12.25 m (cell 64)
+  // and 14.3 m (cell 68), where an obstacle return lies too.
+  const std::vector<P> pts{ { 6.25f, 0.05f, 1.0f }, { 12.25f, 0.1f, 0.0f }, { 14.3f, 0.3f, 0.0f },
+                            { 14.4f, 0.2f, 1.0f } };
+  ScanGridBuilder builder;
+  ScanMassGrid off, on;
+  ScanGridStats st_off, st_on;
+  for (const bool step : { false, true })
+  {
+    p.ground_cells_free = step;
+    builder.configure(p, Eigen::Isometry3d::Identity());
+    ASSERT_TRUE(builder.build(view(pts), step ? on : off, step ? &st_on : &st_off));
+  }
+  for (int x = 43; x <= 51; ++x)
+  {
+    expectFree(off, x, row);
+    expectFree(on, x, row);
+  }
+  for (ScanMassGrid* g : { &off, &on })
+  {
+    expectOccupied(*g, 52, row);
+    expectOccupied(*g, 68, row);
+  }
+  expectUnknown(off, 64, row);
+  expectFree(on, 64, row);  // μ_F of the cell: the ground return's own cell only
+  for (int x = 53; x <= 67; ++x)
+    if (x != 64) expectUnknown(on, x, row);  // the ray's path passed above whatever stands there
+  EXPECT_EQ(st_on.free_cells, st_off.free_cells + 1);
+
+  // With the decay, the cell's μ_F is that of its centre's range, as in front of the obstacle.
+  p.free_decay_length = 20.0;
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(pts), on));
+  expectFree(on, 64, row, static_cast<float>(0.7 * std::exp(-std::hypot(12.25, 0.25) / 20.0)));
+
+  // Step ambiguous unknown still takes the free mass of a cell holding an ambiguous return back.
+  p.free_decay_length = 0.0;
+  p.ambiguous_unknown = true;
+  std::vector<P> with_gap = pts;
+  with_gap.push_back({ 12.4f, 0.2f, 0.25f });  // between the ground and obstacle bands, in cell 64
+  builder.configure(p, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(builder.build(view(with_gap), on));
+  expectUnknown(on, 64, row);
+}

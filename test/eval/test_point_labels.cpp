@@ -184,3 +184,44 @@ TEST(PointLabels, RatiosOfCounts)
   EXPECT_DOUBLE_EQ(eval::f1Score(3.0, 1.0, 2.0), 6.0 / 9.0);
   EXPECT_EQ(eval::f1Score(0.0, 0.0, 0.0), -1.0);
 }
+
+TEST(PointLabels, GroundCellsNotDecidedFreeAreCountedByWhatTheScanGaveThem)
+{
+  using eval::ScanEvidence;
+  constexpr std::int8_t kOccupied = static_cast<std::int8_t>(core::CellClass::kOccupied);
+  eval::PointLabelScorer s(1.0);
+  // Five ground cells: 0 decided F, the others not. The scan gave 0 free, 1 free mass cleared away, 2 occupied mass,
+  // 3 and 4 no mass; cell 4 holds a return in the height gap, so it is ambiguous, cell 3 unreached.
+  const eval::ClassGrid decision = row({ kF, kUnknown, kOccupied, kUnknown, kUnknown });
+  eval::EvidenceGrid evidence{ decision.geometry,
+                               { ScanEvidence::kFree, ScanEvidence::kCleared, ScanEvidence::kOccupied,
+                                 ScanEvidence::kUnreached, ScanEvidence::kUnreached } };
+  const std::vector<LabelledPoint> pts{ ground(0.5), ground(1.5), ground(2.5), ground(3.5), ground(4.4), ground(4.6) };
+  std::vector<core::ReturnClass> classes(pts.size(), core::ReturnClass::kGround);
+  classes[5] = core::ReturnClass::kHeightGap;
+  classes[3] = core::ReturnClass::kBelowGround;  // below the ground band: not ambiguous, cell 3 stays unreached
+  eval::refineAmbiguous(evidence, pts, classes);
+  EXPECT_EQ(evidence.cells[3], ScanEvidence::kUnreached);
+  EXPECT_EQ(evidence.cells[4], ScanEvidence::kAmbiguous);
+  EXPECT_EQ(evidence.cells[1], ScanEvidence::kCleared) << "only cells without mass become ambiguous";
+  s.add(0.0, decision, pts, true, &evidence);
+  // A sweep without evidence counts its ground cells for the recall, not for the shares.
+  s.add(0.1, decision, pts, true);
+  const auto m = s.summary();
+  EXPECT_DOUBLE_EQ(m.at("ground_cells_f_recall"), 0.2);
+  EXPECT_DOUBLE_EQ(m.at("counts.ground_cells_with_evidence"), 5.0);
+  EXPECT_DOUBLE_EQ(m.at("ground_cells_not_f.free"), 0.0);
+  for (const char* e : { "cleared", "occupied", "unreached", "ambiguous" })
+    EXPECT_DOUBLE_EQ(m.at(std::string("ground_cells_not_f.") + e), 0.2) << e;
+  // The recall and the shares of the sweeps with evidence add up to one.
+  double sum = m.at("ground_cells_f_recall");
+  for (const auto& name : eval::kScanEvidenceNames) sum += m.at("ground_cells_not_f." + std::string(name));
+  EXPECT_DOUBLE_EQ(sum, 1.0);
+  // Evidence on another geometry is not counted.
+  eval::PointLabelScorer other(1.0);
+  eval::EvidenceGrid shifted = evidence;
+  shifted.geometry.origin_x = 1.0;
+  other.add(0.0, decision, pts, true, &shifted);
+  EXPECT_EQ(other.summary().count("ground_cells_not_f.free"), 0u);
+  EXPECT_THROW(eval::refineAmbiguous(evidence, pts, {}), std::invalid_argument);
+}

@@ -87,12 +87,16 @@ TEST(ReplayVariants, TheConfiguredThePaperTheirAblationsAndOneRowPerAddedStep)
                                      "single_rate", "no_counter" };
   for (const core::AddedStep& step : core::addedSteps())
     if (step.enabled(configured)) expected.push_back("default_without_" + std::string(step.name));
-  expected.push_back("default_with_motion_spreading");  // the step off by default
-  expected.push_back("default_with_ground_zones");      // the ground model that is not the default's
+  expected.push_back("default_with_motion_spreading");   // the steps off by default
+  expected.push_back("default_with_ground_cells_free");
+  expected.push_back("default_with_ground_zones");       // the ground model that is not the default's
   EXPECT_EQ(names, expected);
-  const VariantSpec& spreading = all[all.size() - 2];
+  const VariantSpec& spreading = all[all.size() - 3];
   EXPECT_EQ(spreading.profile.map_grid.motion_share, core::kMotionSpreadingShare);
   EXPECT_EQ(configured.map_grid.motion_share, 0.0) << "off by default";
+  const VariantSpec& ground_cells = all[all.size() - 2];
+  EXPECT_TRUE(ground_cells.profile.scan_grid.ground_cells_free);
+  EXPECT_FALSE(configured.scan_grid.ground_cells_free) << "off by default";
   EXPECT_EQ(all.back().profile.scan_grid.groundModel(), core::GroundModel::kZones);
   core::Profile zones = configured;
   zones.scan_grid.ground_model = "zones";

@@ -105,6 +105,17 @@ struct ScanGridParams
    */
   bool ambiguous_unknown = true;
   /**
+   * Step "ground cells free" (not in the paper): a cell holding a ground return gets free mass (μ_F at its centre's
+   * range) even where it lies beyond the nearest obstacle of its sector. The polar model stops free space at a
+   * sector's first obstacle, but a multi-beam lidar's upper beams pass over low or near objects and hit the ground
+   * behind them: that ground was seen. Only the cells of the ground returns themselves are free, not the ray's path
+   * to them (which passed above whatever stands there). Step ambiguous unknown and the obstacle returns still take a
+   * cell's free mass back. Off by default: on the labelled real sequences it decides more of the ground F, but it
+   * adds false V and labelled-obstacle cells decided F (doc/steps.md; `evaluate`'s row
+   * `default_with_ground_cells_free`).
+   */
+  bool ground_cells_free = false;
+  /**
    * Step "ground consensus" (not in the paper), with a fitted ground model: the other fitted model (`zones` for
    * `planes`, `planes` for `zones`) is fitted to the same returns, and a return that one model puts on the ground and
    * the other in the obstacle band is disputed: it bounds the free space of its sector (the ray ended there) but
@@ -187,6 +198,7 @@ void forEachParam(ScanGridParams& p, Get&& get)
   get("free_margin", p.free_margin, { "m", "cells nearer than this to a sector's first obstacle stay unknown rather than free" });
   get("relative_height_limit", p.relative_height_limit, { "m", "step: a low obstacle return must stand obstacle_min_height above the lowest return around it; 0: off" });
   get("ambiguous_unknown", p.ambiguous_unknown, { "", "step: a cell holding a return neither ground nor obstacle gets no free mass" });
+  get("ground_cells_free", p.ground_cells_free, { "", "step: a cell holding a ground return is free, also beyond its sector's nearest obstacle" });
   get("ground_consensus", p.ground_consensus, { "", "step: a return one fitted ground model calls ground and the other obstacle bounds free space but gives no mass" });
   get("deskew", p.deskew, { "", "step: clouds with a per-point time field are moved to the sensor pose at the stamp" });
   get("deskew_max_sweep_duration", p.deskew_max_sweep_duration, { "s", "a point time beyond this after the stamp skips deskewing" });
@@ -319,6 +331,8 @@ private:
   void prepareStepBuffers(std::size_t n_points, bool fitted);
   /// Step "ambiguous unknown": takes the free mass back from the cells ambiguous_ flags; returns how many were free.
   std::size_t clearAmbiguousFree(float* m_f, float* m_omega) const;
+  /// Step "ground cells free": gives free mass to the cells ground_seen_ flags that have none; returns how many.
+  std::size_t fillGroundCells(float* m_f, float* m_omega) const;
 
   ScanGridParams params_;
   GridGeometry geometry_;
@@ -359,6 +373,7 @@ private:
   bool record_classes_ = false;
   std::vector<ReturnClass> return_classes_;
   std::vector<std::uint8_t> ambiguous_;  // step "ambiguous unknown": per cell, holds an ambiguous return
+  std::vector<std::uint8_t> ground_seen_;  // step "ground cells free": per cell, holds a ground return
   std::vector<std::uint32_t> obstacle_point_;
   std::vector<std::uint32_t> valid_point_;
   // The `planes` ground model: the valid returns (relative to the sensor) and their zones, then the fitter.

@@ -13,6 +13,7 @@
 
 #include "map_aided_fusion/core/return_class.hpp"
 #include "map_aided_fusion/eval/metrics.hpp"
+#include "map_aided_fusion/eval/scan_evidence.hpp"
 
 namespace map_aided_fusion {
 namespace eval {
@@ -54,6 +55,9 @@ struct PointScanScore
   std::array<std::uint64_t, kNumCellClasses + 1> static_cells{};
   std::uint64_t ground_cells = 0;    ///< cells holding ground-class points and no labelled point of another class
   std::uint64_t ground_f_cells = 0;  ///< of those, decided F
+  bool has_evidence = false;         ///< the scan's evidence was given (ground_not_f is counted)
+  /// Labelled-ground cells not decided F, by what the sweep's scan gave them (ScanEvidence codes).
+  std::array<std::uint64_t, kNumScanEvidence> ground_not_f{};
   std::uint64_t obstacle_cells = 0;  ///< cells holding a labelled obstacle point (static or moving)
   std::uint64_t obstacle_f_cells = 0;  ///< of those, decided F (false free)
   std::uint64_t rigid_cells = 0;     ///< cells holding a labelled obstacle point that is not vegetation
@@ -102,6 +106,10 @@ public:
   /// One sweep: the decision grid (map frame) and the sweep's points (map frame); @p labelled false when the
   /// sweep has no ground truth.
   void add(double stamp, const ClassGrid& decision, const std::vector<LabelledPoint>& points, bool labelled);
+  /// add(), and for each labelled-ground cell not decided F what the sweep's scan gave it: @p evidence, on the
+  /// decision's geometry (scanEvidence(), then refineAmbiguous()); nullptr or another geometry: not counted.
+  void add(double stamp, const ClassGrid& decision, const std::vector<LabelledPoint>& points, bool labelled,
+           const EvidenceGrid* evidence);
 
   /**
    * @brief The ScanGrid's ground segmentation of one labelled sweep: @p classes holds what the sensor model made of
@@ -130,7 +138,9 @@ public:
    *        the cells holding an obstacle point other than vegetation), "mover_cells_s_share" (cells holding a moving
    *        obstacle point decided S), "moving_point_iou" (points in V cells
    *        against moving points: TP / (TP + FP + FN); −1 without a moving point or a V point), with
-   *        addSegmentation() "ground_segmentation.{precision,recall,f1,ground_as_obstacle}", and every count
+   *        addSegmentation() "ground_segmentation.{precision,recall,f1,ground_as_obstacle}", with evidence
+   *        "ground_cells_not_f.{free,occupied,cleared,unreached,ambiguous}" (labelled-ground cells not decided F by
+   *        what the sweep's scan gave them, as shares of the labelled-ground cells of those sweeps), and every count
    *        behind them under "counts." (for pooling several sequences: sum the counts, then divide).
    */
   std::map<std::string, double> summary() const;
@@ -138,6 +148,8 @@ public:
 private:
   /// summary()'s ground, obstacle, moving-point and segmentation scores and their counts.
   void addCellAndPointScores(std::map<std::string, double>& m) const;
+  /// summary()'s labelled-ground cells not decided F, by the scan's evidence (nothing without evidence).
+  void addGroundLossScores(std::map<std::string, double>& m) const;
 
   double radius_;
   double settle_;
