@@ -18,7 +18,7 @@ endif()
 # The offline replay (bags through the core, scored, reported): a library, so that tests reach it piece by piece;
 # `evaluate` parses its options and calls it.
 add_library(map_aided_fusion_replay src/replay/offline_replay.cpp src/replay/options.cpp src/replay/report.cpp
-  src/replay/variants.cpp src/replay/npy.cpp)
+  src/replay/variants.cpp src/replay/npy.cpp src/replay/labelled_sweeps.cpp)
 target_link_libraries(map_aided_fusion_replay map_aided_fusion_eval map_aided_fusion_map_io
   map_aided_fusion_scan_grid_nodelet map_aided_fusion_dataset_ros yaml-cpp ${catkin_LIBRARIES})
 add_dependencies(map_aided_fusion_replay ${PROJECT_NAME}_generate_messages_cpp)

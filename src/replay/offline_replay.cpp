@@ -41,6 +41,7 @@
 #include "map_aided_fusion/eval/scan_evidence.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
 #include "map_aided_fusion/map_io/yaml_params.hpp"
+#include "map_aided_fusion/replay/labelled_sweeps.hpp"
 #include "map_aided_fusion/replay/npy.hpp"
 #include "map_aided_fusion/replay/report.hpp"
 #include "map_aided_fusion/replay/variants.hpp"
@@ -396,35 +397,19 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
     return (v.getEndTime() - v.getBeginTime()).toSec();
   }();
   const double snapshot_time = opt.snapshot_time >= 0.0 ? opt.snapshot_time : 0.7 * duration_guess;
-  // Labelled sweeps: the decisions wait for the sweep's points (or the points for the decisions).
-  std::map<std::int64_t, std::vector<eval::ClassGrid>> pending_decisions;
-  std::map<std::int64_t, std::vector<eval::LabelledPoint>> pending_points;
-  // ... and what each variant's ScanGrid made of the sweep's points (its ground segmentation).
-  std::map<std::int64_t, std::vector<std::vector<core::ReturnClass>>> pending_classes;
-  // ... and what each variant's scan gave each window cell (why a labelled-ground cell is not decided F).
-  std::map<std::int64_t, std::vector<eval::EvidenceGrid>> pending_evidence;
+  // Labelled sweeps: what each variant made of the cloud waits for the sweep's points (or the points for it).
+  LabelledSweeps labelled_sweeps;
   auto scorePending = [&](std::int64_t k) {
-    auto d = pending_decisions.find(k);
-    auto p = pending_points.find(k);
-    if (d == pending_decisions.end() || p == pending_points.end()) return;
+    std::optional<LabelledSweep> sweep = labelled_sweeps.take(k);
+    if (!sweep) return;
     const double t = static_cast<double>(k) * 1e-9;
-    const auto classes = pending_classes.find(k);
-    const auto evidence = pending_evidence.find(k);
     for (std::size_t v = 0; v < variants.size(); ++v)
     {
-      eval::EvidenceGrid* ev = evidence != pending_evidence.end() ? &evidence->second[v] : nullptr;
-      if (ev && classes != pending_classes.end() && classes->second[v].size() == p->second.size())
-        eval::refineAmbiguous(*ev, p->second, classes->second[v]);
-      variants[v]->points.add(t, d->second[v], p->second, true, ev);
-      if (classes != pending_classes.end()) variants[v]->points.addSegmentation(p->second, classes->second[v]);
+      scoreSweep(t, sweep->variants[v], sweep->points, variants[v]->points);
       const auto& s = variants[v]->points.sweeps().back();
       csv << (t - *t0) << "," << variants[v]->scores.name << ",1," << s.v_cells << "," << s.false_v << ","
           << s.v_on_static << "," << s.mover_cells << "," << s.mover_v_cells << "\n";
     }
-    pending_decisions.erase(d);
-    pending_points.erase(p);
-    if (classes != pending_classes.end()) pending_classes.erase(classes);
-    if (evidence != pending_evidence.end()) pending_evidence.erase(evidence);
   };
   rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{ "/points", "/ground_truth/points" }));
   for (const rosbag::MessageInstance& m : view)
@@ -436,7 +421,7 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
       if (!point_mode) continue;
       try
       {
-        pending_points[key(cloud->header.stamp)] = toLabelledPoints(*cloud, tf, opt, configured.scan_grid);
+        labelled_sweeps.addPoints(key(cloud->header.stamp), toLabelledPoints(*cloud, tf, opt, configured.scan_grid));
       }
       catch (const tf2::TransformException&)
       {
@@ -520,9 +505,8 @@ ReplayReport runOfflineReplay(const ReplayOptions& opt)
       {
         if (labelled)
         {
-          pending_decisions[k].push_back(v->decision);
-          pending_classes[k].push_back(v->builder.returnClasses());
-          pending_evidence[k].push_back(eval::scanEvidence(v->scan, pose, v->grid, &obstacles));
+          labelled_sweeps.addVariant(k, VariantSweep{ v->decision, v->builder.returnClasses(),
+                                                      eval::scanEvidence(v->scan, pose, v->grid, &obstacles) });
         }
         else
         {

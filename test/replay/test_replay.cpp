@@ -10,6 +10,7 @@
 
 #include "map_aided_fusion/core/parameters.hpp"
 #include "map_aided_fusion/map_io/map_loader.hpp"
+#include "map_aided_fusion/replay/labelled_sweeps.hpp"
 #include "map_aided_fusion/replay/npy.hpp"
 #include "map_aided_fusion/replay/offline_replay.hpp"
 #include "map_aided_fusion/replay/report.hpp"
@@ -263,6 +264,52 @@ TEST(OfflineReplay, AShortDriveIsScoredPerCellWithTheConfiguredAndThePaperProfil
   std::getline(b, line_b);
   std::getline(a, line_a);
   EXPECT_EQ(line_a, line_b) << "a variant's scores do not depend on the others run beside it";
+}
+
+TEST(LabelledSweeps, ASweepIsScoredOnceBothHalvesArrivedInEitherOrder)
+{
+  // One cell of 1 m, decided F, holding a ground point and a point in the height gap.
+  eval::ClassGrid decision;
+  decision.geometry.resolution = 1.0;
+  decision.geometry.width = decision.geometry.height = 1;
+  decision.cells = { static_cast<std::int8_t>(core::CellClass::kUnknown) };
+  eval::LabelledPoint ground;
+  ground.p = core::Point2{ 0.5, 0.5 };
+  ground.state = eval::LabelState::kStatic;
+  ground.ground = true;
+  const std::vector<eval::LabelledPoint> points{ ground, ground };
+  const VariantSweep half{ decision,
+                           { core::ReturnClass::kGround, core::ReturnClass::kHeightGap },
+                           eval::EvidenceGrid{ decision.geometry, { eval::ScanEvidence::kUnreached } } };
+
+  LabelledSweeps sweeps;
+  sweeps.addPoints(1, points);  // the points first
+  EXPECT_FALSE(sweeps.take(1).has_value());
+  sweeps.addVariant(1, half);
+  sweeps.addVariant(1, half);
+  sweeps.addVariant(2, half);  // the decisions first
+  EXPECT_EQ(sweeps.waiting(), 2u);
+  std::optional<LabelledSweep> one = sweeps.take(1);
+  ASSERT_TRUE(one.has_value());
+  EXPECT_EQ(one->variants.size(), 2u);
+  EXPECT_EQ(one->points.size(), 2u);
+  EXPECT_FALSE(sweeps.take(1).has_value()) << "taken once";
+  EXPECT_EQ(sweeps.waiting(), 1u);
+  sweeps.addPoints(2, points);
+  EXPECT_TRUE(sweeps.take(2).has_value());
+  EXPECT_EQ(sweeps.waiting(), 0u);
+
+  // Scoring one half: the gap return makes the unreached cell ambiguous, and the segmentation is counted.
+  eval::PointLabelScorer scorer(1.0);
+  scoreSweep(0.0, one->variants[0], one->points, scorer);
+  EXPECT_EQ(one->variants[0].evidence.cells[0], eval::ScanEvidence::kAmbiguous);
+  const auto m = scorer.summary();
+  EXPECT_DOUBLE_EQ(m.at("ground_cells_not_f.ambiguous"), 1.0);
+  EXPECT_DOUBLE_EQ(m.at("counts.segmentation_tp"), 1.0);
+  EXPECT_DOUBLE_EQ(m.at("counts.segmentation_fn"), 1.0);
+  VariantSweep mismatched = half;
+  mismatched.classes.pop_back();
+  EXPECT_THROW(scoreSweep(0.0, mismatched, points, scorer), std::invalid_argument);
 }
 
 }  // namespace
